@@ -1,0 +1,1 @@
+"""Camera calibration and the image front end (undistortion, silhouettes)."""

@@ -1,0 +1,1 @@
+"""Body model, cost, optimisers, measurements, reports and the `fitter` CLI."""

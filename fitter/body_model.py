@@ -1,0 +1,254 @@
+"""The statistical body model: PCA shape space, 4-DOF skinning rig, part labels, landmarks.
+
+bodyfit's equivalent of the paper's S-SCAPE model (Section 3.2, Eq. 1-3), built from the
+Anny body model by :mod:`bodyfit.fitter.model_build`. A body is
+
+    rest = mean + sum_k betas[k] * sqrt(eigenvalues[k]) * components[k]      (Eq. 1)
+    posed_i = rest_i + sum_c w_ic * (R_c(pose_c) (rest_i - j_c) + j_c - rest_i)  (Eq. 2)
+
+where the shape vector stacks the rest vertices *and* the four rig joints, so the joints
+follow the shape linearly; ``betas`` are in units of standard deviation (the paper draws
+them in +-3); ``w_ic`` is the skinning weight of vertex i on moving chain c (Anny's bone
+weights summed over the chain); ``R_c`` rotates about the model's y axis (the frontal
+plane) by the chain's abduction angle.
+
+Frame and units everywhere: metres, model frame, z up, -y forward (the body faces -y),
++x is the body's left.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from pathlib import Path
+
+import numpy as np
+
+from bodyfit.calib.errors import UserError
+
+__all__ = [
+    "PART_NAMES",
+    "POSE_NAMES",
+    "FORMAT_VERSION",
+    "BodyModel",
+    "abduction_rotations",
+    "forward",
+    "rest_shape",
+]
+
+#: The nine body parts of the paper's Table 2, in label order (label = index).
+PART_NAMES = ("head", "chest", "waist", "hip", "leg", "foot", "arm", "elbow", "hand")
+
+#: The paper's 4 pose DOF: abduction in the frontal plane, positive = limb moves away
+#: from the body's midline. Order of the ``pose`` columns and of the rig chains/joints.
+POSE_NAMES = (
+    "shoulder_abduction_left",
+    "shoulder_abduction_right",
+    "hip_abduction_left",
+    "hip_abduction_right",
+)
+#: +1 for chains on the body's left (+x), -1 on the right: abduction turns them opposite ways.
+POSE_SIDES = np.array([1.0, -1.0, 1.0, -1.0])
+
+#: Bumped whenever the file layout or the build changes meaning; older caches are rebuilt.
+FORMAT_VERSION = 1
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class BodyModel:
+    """Model data, loaded once. Shapes: V vertices, F faces, C stored components, J=4.
+
+    Attributes:
+        mean_vertices: (V, 3) float32, metres, model frame; rest (A-pose) mean body.
+        mean_joints: (4, 3) float32, metres; rig joints (shoulders, hips) of the mean body,
+            in ``POSE_NAMES`` order.
+        vertex_components: (C, V, 3) float32; orthonormal PCA directions (vertex part),
+            sorted by decreasing eigenvalue.
+        joint_components: (C, 4, 3) float32; the joint part of the same directions.
+        eigenvalues: (C,) float64, m^2; variance of the population along each direction.
+        faces: (F, 3) int32; triangles, counter-clockwise seen from outside.
+        vertex_parts: (V,) int8; index into ``PART_NAMES``.
+        chain_weights: (V, 4) float32 in [0, 1]; skinning weight of each vertex on each
+            moving chain (left arm, right arm, left leg, right leg); rows sum to <= 1.
+        landmarks: name -> (n,) int32 vertex indices used by the measurements.
+        metadata: how the model was built (anny version, seed, samples, timings).
+    """
+
+    mean_vertices: np.ndarray
+    mean_joints: np.ndarray
+    vertex_components: np.ndarray
+    joint_components: np.ndarray
+    eigenvalues: np.ndarray
+    faces: np.ndarray
+    vertex_parts: np.ndarray
+    chain_weights: np.ndarray
+    landmarks: dict[str, np.ndarray]
+    metadata: dict
+
+    @property
+    def num_vertices(self) -> int:
+        return self.mean_vertices.shape[0]
+
+    @property
+    def num_components(self) -> int:
+        return self.eigenvalues.shape[0]
+
+    @property
+    def face_parts(self) -> np.ndarray:
+        """(F,) int8: part of each face, the part most of its three vertices carry
+        (the first vertex's part on a three-way tie)."""
+        p = self.vertex_parts[self.faces]
+        return np.where(p[:, 1] == p[:, 2], p[:, 1], p[:, 0]).astype(np.int8)
+
+    def shape_directions(self, num_betas: int) -> tuple[np.ndarray, np.ndarray]:
+        """Components scaled by their standard deviation, for betas in units of sigma.
+
+        Returns:
+            vertex_dirs: (K, V, 3) float32, metres per sigma.
+            joint_dirs: (K, 4, 3) float32, metres per sigma.
+        """
+        if not 1 <= num_betas <= self.num_components:
+            raise UserError(
+                f"the body model stores {self.num_components} shape components; "
+                f"asked for {num_betas}. Rebuild it with `fitter model build --components N`."
+            )
+        std = np.sqrt(self.eigenvalues[:num_betas]).astype(np.float32)[:, None, None]
+        return self.vertex_components[:num_betas] * std, self.joint_components[:num_betas] * std
+
+    # ----------------------------------------------------------------- file I/O
+    def save(self, path: Path) -> None:
+        """Write an uncompressed .npz atomically (a temporary file, then a rename)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        arrays = {
+            f.name: getattr(self, f.name)
+            for f in dataclasses.fields(self)
+            if f.name not in ("landmarks", "metadata")
+        }
+        arrays.update({f"landmark:{k}": v for k, v in self.landmarks.items()})
+        meta = dict(self.metadata, format_version=FORMAT_VERSION)
+        arrays["metadata_json"] = np.array(json.dumps(meta))
+        tmp = path.with_name(path.name + ".partial")
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **arrays)
+        tmp.replace(path)
+
+    @classmethod
+    def load(cls, path: Path) -> "BodyModel":
+        """Read a model written by :meth:`save`.
+
+        Raises:
+            UserError: the file is missing, unreadable, of another format version, or
+                its arrays are inconsistent.
+        """
+        path = Path(path)
+        try:
+            with np.load(path, allow_pickle=False) as npz:
+                files = dict(npz.items())
+        except FileNotFoundError:
+            raise UserError(f"no body model at {path}; run `fitter model build`") from None
+        except Exception as exc:  # zip, pickle and value errors: all mean "corrupt"
+            raise UserError(f"body model file {path} is corrupt ({exc}); "
+                            "run `fitter model build` to rebuild it") from None
+        try:
+            meta = json.loads(str(files.pop("metadata_json")))
+            if meta.get("format_version") != FORMAT_VERSION:
+                raise UserError(
+                    f"body model {path} has format {meta.get('format_version')}, this "
+                    f"bodyfit reads {FORMAT_VERSION}; run `fitter model build`")
+            landmarks = {k.split(":", 1)[1]: files.pop(k)
+                         for k in list(files) if k.startswith("landmark:")}
+            model = cls(**files, landmarks=landmarks, metadata=meta)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise UserError(f"body model file {path} is incomplete ({exc}); "
+                            "run `fitter model build` to rebuild it") from None
+        model.validate()
+        return model
+
+    def validate(self) -> None:
+        """Check that the arrays agree in shape; raise UserError naming the first that doesn't."""
+        v, c = self.num_vertices, self.num_components
+        expected = {
+            "mean_vertices": (v, 3),
+            "mean_joints": (4, 3),
+            "vertex_components": (c, v, 3),
+            "joint_components": (c, 4, 3),
+            "eigenvalues": (c,),
+            "vertex_parts": (v,),
+            "chain_weights": (v, 4),
+        }
+        for name, shape in expected.items():
+            if getattr(self, name).shape != shape:
+                raise UserError(f"body model array {name} has shape "
+                                f"{getattr(self, name).shape}, expected {shape}; "
+                                "run `fitter model build` to rebuild it")
+        if self.faces.ndim != 2 or self.faces.shape[1] != 3 or self.faces.max() >= v:
+            raise UserError("body model faces are inconsistent; run `fitter model build`")
+
+
+def rest_shape(model: BodyModel, betas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 1: rest-pose vertices and rig joints of each body.
+
+    Args:
+        betas: (P, K) float, shape coefficients in units of standard deviation, K <= C.
+
+    Returns:
+        vertices: (P, V, 3) float32, metres, model frame.
+        joints: (P, 4, 3) float32, metres.
+    """
+    betas = np.asarray(betas, dtype=np.float32)
+    if betas.ndim != 2:
+        raise ValueError(f"betas must have shape (P, K), got {betas.shape}")
+    vertex_dirs, joint_dirs = model.shape_directions(betas.shape[1])
+    vertices = model.mean_vertices + np.einsum("pk,kvd->pvd", betas, vertex_dirs)
+    joints = model.mean_joints + np.einsum("pk,kjd->pjd", betas, joint_dirs)
+    return vertices.astype(np.float32), joints.astype(np.float32)
+
+
+def abduction_rotations(pose_deg: np.ndarray) -> np.ndarray:
+    """Rotation matrices of the four chains, in the frontal (x-z) plane about the y axis.
+
+    A positive angle moves the limb away from the midline: the left chains (+x side) turn
+    a downward vector (0, 0, -1) towards +x, the right chains towards -x.
+
+    Args:
+        pose_deg: (P, 4) float, degrees, in ``POSE_NAMES`` order.
+
+    Returns:
+        (P, 4, 3, 3) float64 rotation matrices acting on column vectors (x, y, z).
+    """
+    theta = np.deg2rad(np.asarray(pose_deg, dtype=np.float64)) * POSE_SIDES
+    c, s = np.cos(theta), np.sin(theta)
+    rot = np.zeros(theta.shape + (3, 3))
+    rot[..., 0, 0] = c
+    rot[..., 0, 2] = -s
+    rot[..., 1, 1] = 1.0
+    rot[..., 2, 0] = s
+    rot[..., 2, 2] = c
+    return rot
+
+
+def forward(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
+    """NumPy reference forward (Eq. 1-3): shape blend, then linear blend skinning.
+
+    The Warp kernels of :mod:`bodyfit.kernels` are checked against this function.
+
+    Args:
+        betas: (P, K) float, shape coefficients in units of standard deviation.
+        pose_deg: (P, 4) float, abduction angles in degrees, ``POSE_NAMES`` order.
+
+    Returns:
+        (P, V, 3) float32 posed vertices, metres, model frame.
+    """
+    pose_deg = np.asarray(pose_deg, dtype=np.float64)
+    betas = np.asarray(betas)
+    if betas.ndim != 2 or pose_deg.shape != (betas.shape[0], len(POSE_NAMES)):
+        raise ValueError(f"betas must be (P, K) and pose (P, 4); got {betas.shape} "
+                         f"and {pose_deg.shape}")
+    rest, joints = rest_shape(model, betas)
+    rot = abduction_rotations(pose_deg)  # (P, 4, 3, 3)
+    offset = rest[:, None, :, :] - joints[:, :, None, :]  # (P, 4, V, 3)
+    moved = np.einsum("pcij,pcvj->pcvi", rot, offset) + joints[:, :, None, :]
+    delta = moved - rest[:, None, :, :]  # (P, 4, V, 3)
+    posed = rest + np.einsum("vc,pcvd->pvd", model.chain_weights, delta)
+    return posed.astype(np.float32)

@@ -1,0 +1,1 @@
+"""Data files shipped with bodyfit (derived tables; see tools/)."""

@@ -1,0 +1,1 @@
+"""Warp kernels: skin, project, rasterise and score whole populations of bodies."""
