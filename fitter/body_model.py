@@ -71,6 +71,10 @@ class BodyModel:
         chain_weights: (V, 4) float32 in [0, 1]; skinning weight of each vertex on each
             moving chain (left arm, right arm, left leg, right leg); rows sum to <= 1.
         landmarks: name -> (n,) int32 vertex indices used by the measurements.
+        population_betas: (N, C) float32; the shape coefficients (in sigma) of the N
+            bodies the space was learned from.
+        population_sex: (N,) int8; 0 man, 1 woman.
+        population_measurements: (N, 16) float32, mm; their measurements, keys A..P.
         metadata: how the model was built (anny version, seed, samples, timings).
     """
 
@@ -83,6 +87,9 @@ class BodyModel:
     vertex_parts: np.ndarray
     chain_weights: np.ndarray
     landmarks: dict[str, np.ndarray]
+    population_betas: np.ndarray
+    population_sex: np.ndarray
+    population_measurements: np.ndarray
     metadata: dict
 
     @property
@@ -176,6 +183,8 @@ class BodyModel:
             "eigenvalues": (c,),
             "vertex_parts": (v,),
             "chain_weights": (v, 4),
+            "population_betas": (len(self.population_sex), c),
+            "population_measurements": (len(self.population_sex), 16),
         }
         for name, shape in expected.items():
             if getattr(self, name).shape != shape:

@@ -1,0 +1,242 @@
+"""The paper's 16 body measurements (its Fig. 10), taken on a body in the model's topology.
+
+Every measurement is taken on the rest (A-pose) body, standing on the floor (its lowest
+vertex), in millimetres. Circumferences are tape measures: the perimeter of the convex
+hull of a plane section (:mod:`bodyfit.fitter.sections`), restricted to the body part
+being measured; limbs are cut perpendicular to the limb's axis (the line between the
+centroids of its two joint rings), the trunk and the head horizontally. Limb values are
+the mean of the left and right sides. Lengths are straight lines between landmarks (the
+paper: "straight lines represent the Euclidean distance").
+
+Definitions, with the ISO 8559-1:2017 clause where one exists and ANSUR II's procedure
+(the reference population, ``shared/data/ansur2``) otherwise:
+
+=====  ======================  ============================================================
+key    name                    definition
+=====  ======================  ============================================================
+A      head circumference      maximum horizontal girth of the skull above the brow: planes
+                               from 50 % to 80 % of the way from the neck-top ring to the
+                               vertex (ISO 8559-1 5.3.1 head girth)
+B      neck circumference      perpendicular to the neck axis, midway between the neck's
+                               base and top rings, just below the larynx (ISO 5.3.2)
+C      shoulder-crotch length  vertical distance from the acromion height (mean of both
+                               sides) down to the crotch point (no ISO clause)
+D      chest circumference     horizontal girth of the trunk at the height of the bust
+                               points (ISO 5.3.4 chest girth; ANSUR: at nipple level)
+E      waist circumference     horizontal girth of the trunk at the navel (omphalion), as
+                               ANSUR II takes it (ISO 5.3.10 uses the natural waist)
+F      pelvis circumference    horizontal girth of trunk and thighs at the height of the
+                               greatest posterior protrusion of the buttocks (ISO 5.3.13
+                               hip girth; ANSUR buttock circumference)
+G      wrist circumference     perpendicular to the forearm at the wrist ring (ISO 5.3.19)
+H      bicep circumference     perpendicular to the upper arm, midway between acromion and
+                               elbow ring, arm relaxed (ISO 5.3.16 upper arm girth; ANSUR
+                               measures it flexed, about 2-3 cm larger)
+I      forearm circumference   maximum girth perpendicular to the forearm, 10-40 % of the way
+                               from elbow to wrist (ANSUR forearm circumference, relaxed here)
+J      arm length              acromion to radiale (outer elbow) plus radiale to stylion
+                               (outer wrist) (ANSUR acromion-radiale + radiale-stylion length)
+K      inside leg length       height of the crotch point above the floor (ISO 5.1.15; ANSUR
+                               crotch height)
+L      thigh circumference     perpendicular to the thigh axis, 2 % of stature below the
+                               crotch: the gluteal fold (ISO 5.3.20; ANSUR thigh circ.)
+M      calf circumference      maximum girth perpendicular to the shank, 20-50 % of the way
+                               from knee to ankle (ISO 5.3.24)
+N      ankle circumference     minimum girth perpendicular to the shank, 75-92 % of the way
+                               from knee to ankle, above the malleoli (ANSUR ankle circ.)
+O      stature                 top of the head to the floor (ISO 5.1.1 body height)
+P      shoulder breadth        straight distance between the two acromion landmarks
+                               (ANSUR biacromial breadth)
+=====  ======================  ============================================================
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from bodyfit.fitter.body_model import PART_NAMES, BodyModel
+from bodyfit.fitter.sections import mesh_edges, region_edges, tape_lengths
+
+__all__ = ["MEASUREMENTS", "IMPORTANT", "Measurer"]
+
+#: key -> (snake_case name, human name), in the paper's Fig. 10 order.
+MEASUREMENTS = {
+    "A": ("head_circumference", "head circumference"),
+    "B": ("neck_circumference", "neck circumference"),
+    "C": ("shoulder_crotch_length", "shoulder to crotch length"),
+    "D": ("chest_circumference", "chest circumference"),
+    "E": ("waist_circumference", "waist circumference"),
+    "F": ("pelvis_circumference", "pelvis (hip) circumference"),
+    "G": ("wrist_circumference", "wrist circumference"),
+    "H": ("bicep_circumference", "bicep circumference"),
+    "I": ("forearm_circumference", "forearm circumference"),
+    "J": ("arm_length", "arm length"),
+    "K": ("inside_leg_length", "inside leg length"),
+    "L": ("thigh_circumference", "thigh circumference"),
+    "M": ("calf_circumference", "calf circumference"),
+    "N": ("ankle_circumference", "ankle circumference"),
+    "O": ("stature", "stature"),
+    "P": ("shoulder_breadth", "shoulder breadth"),
+}
+#: The paper's 7 "visually important" measurements (its Table 4).
+IMPORTANT = ("B", "C", "D", "E", "F", "L", "P")
+
+_UP = np.array([0.0, 0.0, 1.0])
+_SIDES = ("L", "R")
+
+
+@dataclasses.dataclass(frozen=True)
+class _Limb:
+    upper_ring: str  # ring at the proximal joint
+    lower_ring: str  # ring at the distal joint
+    region: tuple[str, ...]  # bone groups whose edges the tape may touch
+
+
+_LIMBS = {
+    "upperarm": _Limb("shoulder", "elbow", ("upperarm",)),
+    "forearm": _Limb("elbow", "wrist", ("forearm",)),
+    "wrist": _Limb("elbow", "wrist", ("forearm", "hand")),
+    "thigh": _Limb("hip", "knee", ("thigh",)),
+    "shank": _Limb("knee", "ankle", ("shank",)),
+}
+
+
+class Measurer:
+    """Takes the 16 measurements on bodies of one model's topology.
+
+    Precomputes the edges of every region once; :meth:`measure` then costs a few
+    milliseconds per body.
+    """
+
+    def __init__(self, faces: np.ndarray, landmarks: dict[str, np.ndarray],
+                 vertex_parts: np.ndarray) -> None:
+        """
+        Args:
+            faces: (F, 3) int triangles of the topology.
+            landmarks: the model's landmarks (:func:`bodyfit.fitter.parts.landmarks`).
+            vertex_parts: (V,) int part labels (``PART_NAMES`` indices).
+        """
+        self.landmarks = landmarks
+        v = len(vertex_parts)
+        edges = mesh_edges(faces)
+
+        def groups(names):
+            m = np.zeros(v, bool)
+            m[np.concatenate([landmarks[f"region:{n}"] for n in names])] = True
+            return m
+
+        self._edges = {
+            "trunk": region_edges(edges, groups(["torso"])),
+            "trunk_thighs": region_edges(edges, groups(["torso", "thigh.L", "thigh.R"])),
+            "neck": region_edges(edges, groups(["neck"])),
+            "skull": region_edges(edges, groups(["skull"])),
+        }
+        for limb, spec in _LIMBS.items():
+            for side in _SIDES:
+                self._edges[f"{limb}.{side}"] = region_edges(
+                    edges, groups([f"{g}.{side}" for g in spec.region]))
+        self._buttock_vertices = np.flatnonzero(vertex_parts == PART_NAMES.index("hip"))
+        self.num_vertices = v
+
+    @classmethod
+    def from_model(cls, model: BodyModel) -> "Measurer":
+        return cls(model.faces, model.landmarks, model.vertex_parts)
+
+    def _point(self, vertices: np.ndarray, name: str) -> np.ndarray:
+        return vertices[self.landmarks[name]].astype(np.float64)
+
+    def _ring(self, vertices: np.ndarray, joint: str, side: str = "") -> np.ndarray:
+        key = f"ring:{joint}.{side}" if side else f"ring:{joint}"
+        return vertices[self.landmarks[key]].astype(np.float64).mean(axis=0)
+
+    def _limb_girths(self, vertices: np.ndarray, limb: str, fractions: np.ndarray,
+                     reduce) -> float:
+        """Mean over both sides of ``reduce`` over girths perpendicular to the limb axis at
+        ``fractions`` (0 = proximal ring centroid, 1 = distal) of the axis."""
+        spec = _LIMBS[limb]
+        values = []
+        for side in _SIDES:
+            top = self._ring(vertices, spec.upper_ring, side)
+            bottom = self._ring(vertices, spec.lower_ring, side)
+            axis = bottom - top
+            origins = top + np.outer(fractions, axis)
+            girths = tape_lengths(vertices, self._edges[f"{limb}.{side}"], origins, axis)
+            values.append(reduce(girths))
+        return float(np.mean(values))
+
+    def _horizontal_girth(self, vertices: np.ndarray, region: str, heights) -> np.ndarray:
+        heights = np.atleast_1d(heights)
+        origins = np.zeros((len(heights), 3))
+        origins[:, 2] = heights
+        return tape_lengths(vertices, self._edges[region], origins, _UP)
+
+    def measure(self, vertices: np.ndarray) -> dict[str, float]:
+        """The 16 measurements of one body.
+
+        Args:
+            vertices: (V, 3) float, metres, model frame, rest A-pose.
+
+        Returns:
+            key ("A".."P") -> value in millimetres; NaN where a section misses the body
+            (a mesh far outside the model's shape space).
+        """
+        v = np.asarray(vertices, np.float64)
+        floor, top = v[:, 2].min(), v[:, 2].max()
+        stature = top - floor
+        crotch = self._point(v, "crotch")[0]
+        acromion = self._point(v, "acromion")
+        out = {}
+
+        neck_top = self._ring(v, "neck_top")
+        span = top - neck_top[2]
+        out["A"] = np.nanmax(self._horizontal_girth(
+            v, "skull", neck_top[2] + span * np.linspace(0.5, 0.8, 7)))
+        base = self._ring(v, "neck_base")
+        out["B"] = tape_lengths(v, self._edges["neck"], [0.5 * (base + neck_top)],
+                                neck_top - base)[0]
+        out["C"] = acromion[:, 2].mean() - crotch[2]
+        out["D"] = self._horizontal_girth(v, "trunk", self._point(v, "bust")[:, 2].mean())[0]
+        out["E"] = self._horizontal_girth(v, "trunk", self._point(v, "navel")[0, 2])[0]
+        buttocks = v[self._buttock_vertices]
+        out["F"] = self._horizontal_girth(v, "trunk_thighs",
+                                          buttocks[np.argmax(buttocks[:, 1]), 2])[0]
+        out["G"] = self._limb_girths(v, "wrist", np.array([1.0]), np.nanmax)
+        out["H"] = self._upper_arm_girth(v, acromion)
+        out["I"] = self._limb_girths(v, "forearm", np.linspace(0.1, 0.4, 7), np.nanmax)
+        radiale, stylion = self._point(v, "radiale"), self._point(v, "stylion")
+        out["J"] = float(np.mean(np.linalg.norm(acromion - radiale, axis=1)
+                                 + np.linalg.norm(radiale - stylion, axis=1)))
+        out["K"] = crotch[2] - floor
+        out["L"] = self._thigh_girth(v, crotch[2] - 0.02 * stature)
+        out["M"] = self._limb_girths(v, "shank", np.linspace(0.2, 0.5, 7), np.nanmax)
+        out["N"] = self._limb_girths(v, "shank", np.linspace(0.75, 0.92, 6), np.nanmin)
+        out["O"] = stature
+        out["P"] = float(np.linalg.norm(acromion[0] - acromion[1]))
+        return {k: float(out[k]) * 1000.0 for k in MEASUREMENTS}
+
+    def _upper_arm_girth(self, v: np.ndarray, acromion: np.ndarray) -> float:
+        values = []
+        for i, side in enumerate(_SIDES):
+            shoulder = self._ring(v, "shoulder", side)
+            elbow = self._ring(v, "elbow", side)
+            origin = 0.5 * (acromion[i] + elbow)
+            values.append(tape_lengths(v, self._edges[f"upperarm.{side}"], [origin],
+                                       elbow - shoulder)[0])
+        return float(np.mean(values))
+
+    def _thigh_girth(self, v: np.ndarray, height: float) -> float:
+        """Girth perpendicular to each thigh where its axis passes ``height`` (metres)."""
+        values = []
+        for side in _SIDES:
+            hip, knee = self._ring(v, "hip", side), self._ring(v, "knee", side)
+            t = (hip[2] - height) / (hip[2] - knee[2])
+            values.append(tape_lengths(v, self._edges[f"thigh.{side}"],
+                                       [hip + t * (knee - hip)], knee - hip)[0])
+        return float(np.mean(values))
+
+    def measure_many(self, vertices: np.ndarray) -> np.ndarray:
+        """(N, 16) float64 measurements in mm, columns in ``MEASUREMENTS`` order, of
+        ``vertices`` (N, V, 3) metres."""
+        return np.array([[m[k] for k in MEASUREMENTS] for m in map(self.measure, vertices)])

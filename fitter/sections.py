@@ -1,0 +1,101 @@
+"""Plane sections of a body mesh and their tape-measure length.
+
+A tape measure drawn around a body part follows the convex hull of the part's cross
+section: it bridges the concave dips (the gap between the buttocks, the navel). So a
+circumference here is the perimeter of the 2D convex hull of the points where the plane
+cuts the mesh's edges. The edges considered can be restricted to a region (one limb, the
+torso without the arms), which is how a tape is kept off the neighbouring parts.
+
+All lengths are metres, model frame.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+__all__ = ["mesh_edges", "region_edges", "plane_basis", "section_points", "tape_lengths"]
+
+
+def mesh_edges(faces: np.ndarray) -> np.ndarray:
+    """Unique undirected edges of a triangle mesh.
+
+    Args:
+        faces: (F, 3) int triangle vertex indices.
+
+    Returns:
+        (E, 2) int32, each row sorted (smaller index first).
+    """
+    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    return np.unique(np.sort(e, axis=1), axis=0).astype(np.int32)
+
+
+def region_edges(edges: np.ndarray, vertex_mask: np.ndarray) -> np.ndarray:
+    """(E', 2) int32: the edges whose two vertices both lie in the region ``vertex_mask`` (V,) bool."""
+    return edges[vertex_mask[edges[:, 0]] & vertex_mask[edges[:, 1]]]
+
+
+def plane_basis(normal: np.ndarray) -> np.ndarray:
+    """(2, 3) float64 orthonormal in-plane axes for a plane of unit ``normal`` (3,)."""
+    n = np.asarray(normal, np.float64)
+    n = n / np.linalg.norm(n)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(n, helper)
+    u /= np.linalg.norm(u)
+    return np.stack([u, np.cross(n, u)])
+
+
+def section_points(vertices: np.ndarray, edges: np.ndarray, origin: np.ndarray,
+                   normal: np.ndarray) -> np.ndarray:
+    """Where the plane through ``origin`` (3,) with ``normal`` (3,) cuts ``edges`` (E, 2).
+
+    Args:
+        vertices: (V, 3) float, metres.
+
+    Returns:
+        (n, 2) float64 points in the plane's 2D frame (:func:`plane_basis`), metres.
+    """
+    return _sections(vertices, edges, np.asarray(origin, np.float64)[None], normal)[0]
+
+
+def _sections(vertices: np.ndarray, edges: np.ndarray, origins: np.ndarray,
+              normal: np.ndarray) -> list[np.ndarray]:
+    """Section points of parallel planes (shared ``normal``), one (n_i, 2) array each."""
+    n = np.asarray(normal, np.float64)
+    n = n / np.linalg.norm(n)
+    offsets = origins @ n
+    a = vertices[edges[:, 0]].astype(np.float64)
+    b = vertices[edges[:, 1]].astype(np.float64)
+    da, db = a @ n, b @ n
+    near = (np.maximum(da, db) > offsets.min()) & (np.minimum(da, db) <= offsets.max())
+    a, b, da, db = a[near], b[near], da[near], db[near]
+    basis = plane_basis(n)
+    a2, b2 = a @ basis.T, b @ basis.T
+    out = []
+    for offset in offsets:
+        sa, sb = da - offset, db - offset
+        cut = (sa > 0) != (sb > 0)
+        t = (sa[cut] / (sa[cut] - sb[cut]))[:, None]
+        out.append(a2[cut] + t * (b2[cut] - a2[cut]))
+    return out
+
+
+def tape_lengths(vertices: np.ndarray, edges: np.ndarray, origins: np.ndarray,
+                 normal: np.ndarray) -> np.ndarray:
+    """Convex-hull perimeter of the sections of parallel planes.
+
+    Args:
+        vertices: (V, 3) float, metres.
+        edges: (E, 2) int, the region's edges (:func:`region_edges`).
+        origins: (N, 3) float, a point of each plane, metres.
+        normal: (3,) float, the planes' common normal (any length > 0).
+
+    Returns:
+        (N,) float64 perimeters in metres; NaN where a plane misses the region.
+    """
+    origins = np.atleast_2d(np.asarray(origins, np.float64))
+    out = np.full(len(origins), np.nan)
+    for i, pts in enumerate(_sections(vertices, edges, origins, normal)):
+        if len(pts) >= 3:
+            out[i] = cv2.arcLength(cv2.convexHull(pts.astype(np.float32)), closed=True)
+    return out
