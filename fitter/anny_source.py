@@ -106,6 +106,9 @@ class AnnySource:
     """
 
     def __init__(self) -> None:
+        import warp
+
+        warp.config.quiet = True  # anny initialises Warp; keep its banner off the CLI
         import anny  # heavy import (torch, warp): only when a model is built
 
         self.anny_version = anny.__version__

@@ -34,6 +34,7 @@ __all__ = [
     "abduction_rotations",
     "forward",
     "rest_shape",
+    "project_shape",
 ]
 
 #: The nine body parts of the paper's Table 2, in label order (label = index).
@@ -212,6 +213,28 @@ def rest_shape(model: BodyModel, betas: np.ndarray) -> tuple[np.ndarray, np.ndar
     vertices = model.mean_vertices + np.einsum("pk,kvd->pvd", betas, vertex_dirs)
     joints = model.mean_joints + np.einsum("pk,kjd->pjd", betas, joint_dirs)
     return vertices.astype(np.float32), joints.astype(np.float32)
+
+
+def project_shape(model: BodyModel, vertices: np.ndarray, joints: np.ndarray,
+                  num_betas: int) -> np.ndarray:
+    """The inverse of :func:`rest_shape`: betas of the closest bodies of the space.
+
+    Orthogonal projection onto the first ``num_betas`` components (least squares over
+    vertices and joints together), i.e. the best reconstruction the space allows.
+
+    Args:
+        vertices: (N, V, 3) float, metres, rest pose, model frame.
+        joints: (N, 4, 3) float, metres, rig joints.
+
+    Returns:
+        (N, num_betas) float64 betas in units of standard deviation.
+    """
+    k = num_betas
+    x = np.concatenate([(vertices - model.mean_vertices).reshape(len(vertices), -1),
+                        (joints - model.mean_joints).reshape(len(joints), -1)], axis=1)
+    comps = np.concatenate([model.vertex_components[:k].reshape(k, -1),
+                            model.joint_components[:k].reshape(k, -1)], axis=1)
+    return (x.astype(np.float64) @ comps.T.astype(np.float64)) / np.sqrt(model.eigenvalues[:k])
 
 
 def abduction_rotations(pose_deg: np.ndarray) -> np.ndarray:

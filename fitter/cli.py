@@ -1,3 +1,141 @@
-"""`fitter` command line (placeholder replaced below)."""
-def main(argv=None):
+"""`fitter`: the body model, measurements and (later) fitting, from the command line.
+
+User errors print one line, ``fitter: error: ...``, and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import time
+from pathlib import Path
+
+from bodyfit.calib.errors import UserError
+
+__all__ = ["main"]
+
+logger = logging.getLogger("bodyfit")
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="fitter",
+        description="bodyfit: 3D body and 16 tape measurements (millimetres) from photos. "
+                    "Lengths in files are metres (meshes) and millimetres (measurements).")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    model = sub.add_parser("model", help="build or inspect the body model")
+    model_sub = model.add_subparsers(dest="model_command", required=True, metavar="ACTION")
+    build = model_sub.add_parser(
+        "build", help="build the body model from Anny into the cache (a few minutes)")
+    build.add_argument("--components", type=int, default=60,
+                       help="PCA shape components to store (default 60; fitting uses 20)")
+    build.add_argument("--samples", type=int, default=3000,
+                       help="bodies in the population, half men, half women (default 3000)")
+    build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    model_sub.add_parser("info", help="print where the model is and how it was built")
+
+    demo = sub.add_parser("demo", help="built-in example: draw bodies, write meshes "
+                                       "(.obj/.ply, metres), measurements (mm) and a picture")
+    demo.add_argument("-o", "--output", type=Path, default=Path("out/demo"),
+                      help="output directory (default out/demo)")
+    demo.add_argument("--bodies", type=int, default=3, help="bodies to draw (default 3)")
+    demo.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+
+    measure = sub.add_parser("measure", help="the 16 measurements (mm) of a mesh in the "
+                                             "model's topology (.obj/.ply)")
+    measure.add_argument("mesh", type=Path, help="mesh file, .obj or .ply")
+    measure.add_argument("--units", choices=("m", "cm", "mm"), default="m",
+                         help="length unit of the mesh file (default m)")
+    measure.add_argument("-o", "--output", type=Path,
+                         help="write JSON here (and CSV beside it); default: print only")
+    return parser
+
+
+def _cmd_model_build(args) -> None:
+    from bodyfit.fitter.model_build import ModelBuildSettings
+    from bodyfit.fitter.model_cache import build_and_save, model_path
+
+    settings = ModelBuildSettings(components=args.components, samples=args.samples,
+                                  seed=args.seed)
+    settings.validate()
+    model = build_and_save(settings)
+    t = model.metadata["timings_s"]
+    print(f"built the body model in {t['total']:.0f} s: {model.num_vertices} vertices, "
+          f"{model.num_components} components, {len(model.population_sex)} bodies")
+    print(f"wrote {model_path()}")
+
+
+def _cmd_model_info(args) -> None:
+    from bodyfit.fitter.model_cache import load_model, model_path
+
+    t0 = time.perf_counter()
+    model = load_model(build_if_needed=False)
+    load_s = time.perf_counter() - t0
+    meta = model.metadata
+    print(f"body model: {model_path()} ({model_path().stat().st_size / 1e6:.1f} MB, "
+          f"loaded in {load_s * 1000:.0f} ms)")
+    print(f"  {model.num_vertices} vertices, {len(model.faces)} faces, "
+          f"{model.num_components} components ({meta['explained_variance']:.6f} of the "
+          f"population's variance)")
+    print(f"  built from anny {meta['anny_version']} with {meta['settings']} "
+          f"in {meta['timings_s']['total']:.0f} s")
+
+
+def _cmd_demo(args) -> None:
+    from bodyfit.fitter.demo import DemoSettings, run_demo
+    from bodyfit.fitter.model_cache import load_model
+
+    if args.bodies < 1:
+        raise UserError(f"--bodies must be at least 1, got {args.bodies}")
+    model = load_model()
+    written = run_demo(model, args.output, DemoSettings(bodies=args.bodies, seed=args.seed))
+    print(f"drew {args.bodies} bodies from the body model; wrote:")
+    for path in written:
+        print(f"  {path}")
+
+
+def _cmd_measure(args) -> None:
+    from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
+    from bodyfit.fitter.mesh_io import read_mesh
+    from bodyfit.fitter.model_cache import load_model
+    from bodyfit.fitter.outputs import write_measurements
+
+    model = load_model()
+    vertices = read_mesh(args.mesh, model.faces, args.units)
+    values = Measurer.from_model(model).measure(vertices)
+    for key, value in values.items():
+        print(f"  {key} {MEASUREMENTS[key][1]:<28} {value:8.1f} mm")
+    if args.output:
+        if args.output.suffix.lower() != ".json":
+            raise UserError(f"-o takes a .json path, got {args.output}")
+        csv_path = write_measurements(args.output, {args.mesh.stem: values},
+                                      {"command": "fitter measure", "mesh": str(args.mesh),
+                                       "units": args.units})
+        print(f"wrote {args.output} and {csv_path}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _build_parser().parse_args(argv)
+    logging.basicConfig(level=logging.ERROR if args.quiet else logging.INFO,
+                        format="%(message)s")
+    for noisy in ("anny", "warp"):
+        logging.getLogger(noisy).setLevel(logging.WARNING)
+    command = {"demo": _cmd_demo, "measure": _cmd_measure}.get(args.command)
+    if args.command == "model":
+        command = {"build": _cmd_model_build, "info": _cmd_model_info}[args.model_command]
+    try:
+        command(args)
+    except UserError as exc:
+        print(f"fitter: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("fitter: interrupted", file=sys.stderr)
+        return 130
     return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

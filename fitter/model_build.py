@@ -62,8 +62,11 @@ def template_body(source: AnnySource) -> tuple[np.ndarray, np.ndarray]:
     return vertices[0], joints[0]
 
 
-def principal_components(shapes: np.ndarray, count: int):
+def principal_components(shapes: np.ndarray, count: int, chunk: int = 4096):
     """PCA of row vectors through the Gram matrix (cheap when rows << columns).
+
+    Accumulates in float64 over column chunks, so the small trailing components stay
+    orthonormal without holding a float64 copy of the data.
 
     Args:
         shapes: (N, D) float32 data, one body per row.
@@ -73,14 +76,21 @@ def principal_components(shapes: np.ndarray, count: int):
         mean: (D,) float64; components: (count, D) float32 orthonormal rows;
         eigenvalues: (count,) float64, variance along each component (unbiased).
     """
+    n, d = shapes.shape
     mean = shapes.mean(axis=0, dtype=np.float64)
-    centred = shapes - mean.astype(np.float32)
-    gram = (centred @ centred.T).astype(np.float64)
+    gram = np.zeros((n, n))
+    for start in range(0, d, chunk):
+        block = shapes[:, start:start + chunk] - mean[start:start + chunk]
+        gram += block @ block.T
     eigval, eigvec = np.linalg.eigh(gram)
     order = np.argsort(eigval)[::-1][:count]
     eigval, eigvec = np.maximum(eigval[order], 1e-30), eigvec[:, order]
-    components = (eigvec.T.astype(np.float32) @ centred) / np.sqrt(eigval)[:, None].astype(np.float32)
-    return mean, components, eigval / (len(shapes) - 1)
+    components = np.empty((count, d))
+    for start in range(0, d, chunk):
+        block = shapes[:, start:start + chunk] - mean[start:start + chunk]
+        components[:, start:start + chunk] = eigvec.T @ block
+    components /= np.sqrt(eigval)[:, None]
+    return mean, components.astype(np.float32), eigval / (n - 1)
 
 
 def build_model(settings: ModelBuildSettings = ModelBuildSettings()) -> BodyModel:

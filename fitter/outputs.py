@@ -1,0 +1,94 @@
+"""Writing result files atomically: a failed run leaves no half-written output.
+
+Every writer writes a temporary file beside the target and renames it into place.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import shutil
+import tempfile
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from bodyfit.calib.errors import UserError
+from bodyfit.fitter.measurements import MEASUREMENTS
+
+__all__ = ["staged_directory", "write_text", "write_png", "write_json", "write_measurements"]
+
+
+@contextlib.contextmanager
+def staged_directory(out_dir: Path):
+    """Yield a fresh staging directory beside ``out_dir``; on success move its files into
+    ``out_dir`` (created if needed), on any error delete it, so ``out_dir`` never holds the
+    files of a failed run."""
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".partial",
+                                  dir=out_dir.parent))
+    try:
+        yield stage
+        out_dir.mkdir(exist_ok=True)
+        for item in sorted(stage.iterdir()):
+            item.replace(out_dir / item.name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def write_text(path: Path, text: str) -> None:
+    path = Path(path)
+    tmp = path.with_name(path.name + ".partial")
+    tmp.write_text(text)
+    tmp.replace(path)
+
+
+def write_png(path: Path, image: np.ndarray) -> None:
+    """Write a (H, W, 3) uint8 BGR (or (H, W) grey) image as PNG, atomically."""
+    ok, data = cv2.imencode(".png", image)
+    if not ok:
+        raise UserError(f"could not encode {path} as PNG")
+    path = Path(path)
+    tmp = path.with_name(path.name + ".partial")
+    tmp.write_bytes(data.tobytes())
+    tmp.replace(path)
+
+
+def write_json(path: Path, payload: dict) -> None:
+    write_text(path, json.dumps(payload, indent=2) + "\n")
+
+
+def write_measurements(json_path: Path, bodies: dict[str, dict[str, float]],
+                       provenance: dict) -> Path:
+    """Write measurements as JSON and, beside it, CSV (same stem), millimetres.
+
+    Args:
+        json_path: target .json path; the CSV goes to the same path with suffix .csv.
+        bodies: body name -> measurement key ("A".."P") -> value in mm.
+        provenance: what produced them (command, model, inputs), stored in the JSON.
+
+    Returns:
+        The CSV path.
+    """
+    json_path = Path(json_path)
+    payload = {
+        "units": "mm",
+        "definitions": {k: {"name": n, "label": label}
+                        for k, (n, label) in MEASUREMENTS.items()},
+        "bodies": {b: {k: round(float(v), 2) for k, v in m.items()} for b, m in bodies.items()},
+        "provenance": provenance,
+    }
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["body", "key", "measurement", "value_mm"])
+    for body, values in bodies.items():
+        for key, value in values.items():
+            writer.writerow([body, key, MEASUREMENTS[key][0], f"{value:.2f}"])
+    csv_path = json_path.with_suffix(".csv")
+    write_json(json_path, payload)
+    write_text(csv_path, buffer.getvalue())
+    return csv_path
