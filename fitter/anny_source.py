@@ -17,6 +17,8 @@ import logging
 
 import numpy as np
 
+from bodyfit.fitter.sections import mesh_edges
+
 __all__ = [
     "BONE_GROUPS",
     "RIG_JOINT_BONES",
@@ -106,9 +108,6 @@ class AnnySource:
     """
 
     def __init__(self) -> None:
-        import warp
-
-        warp.config.quiet = True  # anny initialises Warp; keep its banner off the CLI
         import anny  # heavy import (torch, warp): only when a model is built
 
         self.anny_version = anny.__version__
@@ -139,7 +138,7 @@ class AnnySource:
         m = self.model
         faces = m.faces.cpu().numpy().astype(np.int64)
         n = m.template_vertices.shape[0]
-        edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+        edges = mesh_edges(faces)
         graph = scipy.sparse.coo_matrix((np.ones(len(edges)), edges.T), shape=(n, n))
         _, comp = scipy.sparse.csgraph.connected_components(graph, directed=False)
         main = np.argmax(np.bincount(comp))
@@ -149,7 +148,7 @@ class AnnySource:
         kept_faces = remap[faces[np.all(comp[faces] == main, axis=1)]].astype(np.int32)
 
         labels = list(m.bone_labels)
-        parents = m.bone_parents.tolist() if hasattr(m.bone_parents, "tolist") else m.bone_parents
+        parents = list(m.bone_parents)
         owner = self._bone_owner(labels, parents, BONE_GROUPS)
         chain_owner = self._bone_owner(
             labels, parents, {c: (c,) for c in CHAIN_ROOT_BONES}, default=-1)
@@ -170,8 +169,8 @@ class AnnySource:
 
         Bones under no group root get ``default`` (an error when it is None).
         """
-        roots = {labels.index(b): g for g, (i_group) in enumerate(groups.values())
-                 for b in i_group}
+        roots = {labels.index(bone): g for g, bones in enumerate(groups.values())
+                 for bone in bones}
         owner = np.empty(len(labels), np.int64)
         for b in range(len(labels)):
             a = b

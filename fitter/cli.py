@@ -121,8 +121,10 @@ def main(argv: list[str] | None = None) -> int:
     args = _build_parser().parse_args(argv)
     logging.basicConfig(level=logging.ERROR if args.quiet else logging.INFO,
                         format="%(message)s")
-    for noisy in ("anny", "warp"):
-        logging.getLogger(noisy).setLevel(logging.WARNING)
+    logging.getLogger("anny").setLevel(logging.WARNING)
+    import warp  # Warp prints its banner and module loads at INFO; the CLI keeps to errors
+
+    warp.config.log_level = warp.LOG_ERROR
     command = {"demo": _cmd_demo, "measure": _cmd_measure}.get(args.command)
     if args.command == "model":
         command = {"build": _cmd_model_build, "info": _cmd_model_info}[args.model_command]
