@@ -184,10 +184,6 @@ class AnnySource:
                 owner[b] = roots[a]
         return owner
 
-    @property
-    def parameter_names(self) -> tuple[str, ...]:
-        return SHAPE_PARAMETERS
-
     def rest_bodies(self, gender: np.ndarray, params: np.ndarray,
                     batch_size: int = 128) -> tuple[np.ndarray, np.ndarray]:
         """Rest-pose (A-pose) bodies for parameter rows.

@@ -9,7 +9,9 @@ the mean of the left and right sides. Lengths are straight lines between landmar
 paper: "straight lines represent the Euclidean distance").
 
 Definitions, with the ISO 8559-1:2017 clause where one exists and ANSUR II's procedure
-(the reference population, ``shared/data/ansur2``) otherwise:
+(the reference population the body model is matched to) otherwise. The clause numbers
+are those cited in public sizing literature; the standard's text is not freely available
+to check them against.
 
 =====  ======================  ============================================================
 key    name                    definition
@@ -138,7 +140,6 @@ class Measurer:
                 self._edges[f"{limb}.{side}"] = region_edges(
                     edges, groups([f"{g}.{side}" for g in spec.region]))
         self._buttock_vertices = np.flatnonzero(vertex_parts == PART_NAMES.index("hip"))
-        self.num_vertices = v
 
     @classmethod
     def from_model(cls, model: BodyModel) -> "Measurer":

@@ -38,6 +38,14 @@ class ModelBuildSettings:
     components: int = 60  # PCA components stored (the fitter uses 20 by default)
     samples: int = 3000  # bodies in the population, half men, half women
     seed: int = 0
+    population: PopulationSettings = PopulationSettings()
+
+    @classmethod
+    def of(cls, model: BodyModel) -> "ModelBuildSettings":
+        """The settings a model was built with (from its metadata)."""
+        recorded = dict(model.metadata["settings"])
+        recorded["population"] = PopulationSettings(**recorded["population"])
+        return cls(**recorded)
 
     def validate(self) -> None:
         from bodyfit.calib.errors import UserError
@@ -105,7 +113,7 @@ def build_model(settings: ModelBuildSettings = ModelBuildSettings()) -> BodyMode
     measurer = Measurer(topo.faces, marks, labels)
     t_setup = time.perf_counter()
 
-    sampler = PopulationSampler(source, measurer)
+    sampler = PopulationSampler(source, measurer, settings.population)
     half = settings.samples // 2
     population = sampler.sample({"male": half, "female": half}, seed=settings.seed)
     t_population = time.perf_counter()
@@ -122,7 +130,6 @@ def build_model(settings: ModelBuildSettings = ModelBuildSettings()) -> BodyMode
         "builder": "bodyfit.fitter.model_build",
         "anny_version": source.anny_version,
         "settings": dataclasses.asdict(settings),
-        "population_settings": dataclasses.asdict(PopulationSettings()),
         "shape_parameters": list(SHAPE_PARAMETERS),
         "explained_variance": float(eigenvalues.sum() / (shapes.var(axis=0, ddof=1).sum())),
         "timings_s": {"setup": round(t_setup - t0, 2),

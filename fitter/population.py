@@ -11,8 +11,8 @@ measurements*:
    forearm girths, which ANSUR takes flexed);
 2. a random start in Anny's parameters (phenotypes near the middle of their range,
    local changes near 0: the variation of what ANSUR does not constrain);
-3. quasi-Newton steps that move the parameters the least (in units of their prior
-   spread) to hit the targets, within the parameters' bounds: a linear map parameters
+3. quasi-Newton steps that move the parameters the least (in units of their scale)
+   to hit the targets, within the parameters' bounds: a linear map parameters
    -> measurements per sex, fitted by least squares on a pool of bodies, refined per
    body by Broyden updates; each body keeps its best evaluated parameters.
 
@@ -43,15 +43,16 @@ _GENDER = {"male": 0.0, "female": 1.0}  # Anny's gender phenotype
 TARGET_KEYS = ("A", "B", "D", "E", "F", "G", "J", "K", "L", "M", "N", "O", "P")
 _KEYS = list(MEASUREMENTS)
 
-#: Start distribution (centre, spread) and bounds of each Anny parameter. Anny's age
-#: 0.77-0.83 spans 18 to 64 years.
+#: Centre, scale and bounds of each Anny parameter. Start values are drawn around the
+#: centre with this scale (local changes: ``PopulationSettings.local_change_spread``), and
+#: fitting steps are measured in it. Anny's age 0.77-0.83 spans 18 to 64 years.
 _PRIOR = {"age": (0.80, 0.015, 0.77, 0.83)} | {
     p: (0.5, 0.15, 0.0, 1.0) for p in PHENOTYPES if p != "age"}
 _LOCAL_PRIOR = (0.0, 0.2, -1.0, 1.0)
 
 
 def _prior_table() -> np.ndarray:
-    """(4, D) rows centre, spread, lower bound, upper bound per ``SHAPE_PARAMETERS``."""
+    """(4, D) rows centre, scale, lower bound, upper bound per ``SHAPE_PARAMETERS``."""
     return np.array([_PRIOR.get(p, _LOCAL_PRIOR) for p in SHAPE_PARAMETERS]).T
 
 
@@ -106,7 +107,9 @@ class PopulationSettings:
     iterations: int = 4  # Gauss-Newton steps per body
     pool_per_sex: int = 400  # bodies for the linear map parameters -> measurements
     measurement_weight_sd: float = 0.05  # a miss of this many ANSUR SDs costs as much as
-    # moving one parameter by its prior spread
+    # moving one parameter by its scale
+    local_change_spread: float = 0.1  # SD of the local changes' start values: the
+    # variation the fitted measurements leave free (0.2 doubles the K=20 floor, docs/model.md)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -140,12 +143,15 @@ class PopulationSampler:
         self.settings = settings
         self.stats = ReferenceStats.load().subset(TARGET_KEYS)
         self._prior = _prior_table()
+        is_local = np.array([p not in PHENOTYPES for p in SHAPE_PARAMETERS])
+        self._start_spread = np.where(is_local, settings.local_change_spread, self._prior[1])
         self._target_cols = [_KEYS.index(k) for k in TARGET_KEYS]
 
     def _start(self, n: int, rng: np.random.Generator, widen: float = 1.0) -> np.ndarray:
         """(n, D) draws of the start distribution, its spread multiplied by ``widen``."""
-        centre, spread, lo, hi = self._prior
-        return np.clip(centre + widen * spread * rng.standard_normal((n, len(centre))), lo, hi)
+        centre, _, lo, hi = self._prior
+        noise = rng.standard_normal((n, len(centre))) * self._start_spread * widen
+        return np.clip(centre + noise, lo, hi)
 
     def _bodies(self, sex: str, params: np.ndarray):
         gender = np.full(len(params), _GENDER[sex])
@@ -178,8 +184,8 @@ class PopulationSampler:
         jacobians = np.repeat(jac[None], n, axis=0)  # (n, k, D) mm per parameter unit
         targets = self.stats.sample(sex, n, rng)
         start = self._start(n, rng)
-        _, spread, lo, hi = self._prior
-        # whitened least squares: rows scaled by 1 / (w * ANSUR SD), columns by the spread
+        _, scale, lo, hi = self._prior
+        # whitened least squares: rows scaled by 1 / (w * ANSUR SD), columns by the scale
         row_scale = 1.0 / (self.settings.measurement_weight_sd * self.stats.std[sex])
         params = start.copy()
         previous = None
@@ -189,7 +195,7 @@ class PopulationSampler:
             measured = meas[:, self._target_cols]
             residual = targets - measured
             objective = (np.sum(np.nan_to_num(row_scale * residual, nan=1e6) ** 2, axis=1)
-                         + np.sum(((params - start) / spread) ** 2, axis=1))
+                         + np.sum(((params - start) / scale) ** 2, axis=1))
             if best is None:
                 best = [objective, params.copy(), vertices, joints, meas]
             else:
@@ -206,15 +212,15 @@ class PopulationSampler:
             previous = (params.copy(), measured)
             residual = np.nan_to_num(residual)
             for b in range(n):
-                # the step u (in prior spreads) minimising |a u - r|^2 + |u + offset|^2
+                # the step u (in parameter scales) minimising |a u - r|^2 + |u + offset|^2
                 # inside the parameter bounds
-                a = row_scale[:, None] * jacobians[b] * spread[None, :]
-                offset = (params[b] - start[b]) / spread
-                step = lsq_linear(np.vstack([a, np.eye(len(spread))]),
+                a = row_scale[:, None] * jacobians[b] * scale[None, :]
+                offset = (params[b] - start[b]) / scale
+                step = lsq_linear(np.vstack([a, np.eye(len(scale))]),
                                   np.concatenate([row_scale * residual[b], -offset]),
-                                  bounds=((lo - params[b]) / spread,
-                                          (hi - params[b]) / spread)).x
-                params[b] = np.clip(params[b] + step * spread, lo, hi)
+                                  bounds=((lo - params[b]) / scale,
+                                          (hi - params[b]) / scale)).x
+                params[b] = np.clip(params[b] + step * scale, lo, hi)
         _, params, vertices, joints, meas = best
         return Population(np.full(n, sex), params, vertices, joints, meas, targets)
 

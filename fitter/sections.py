@@ -14,7 +14,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-__all__ = ["mesh_edges", "region_edges", "plane_basis", "section_points", "tape_lengths"]
+__all__ = ["mesh_edges", "region_edges", "plane_basis", "tape_lengths"]
 
 
 def mesh_edges(faces: np.ndarray) -> np.ndarray:
@@ -45,22 +45,11 @@ def plane_basis(normal: np.ndarray) -> np.ndarray:
     return np.stack([u, np.cross(n, u)])
 
 
-def section_points(vertices: np.ndarray, edges: np.ndarray, origin: np.ndarray,
-                   normal: np.ndarray) -> np.ndarray:
-    """Where the plane through ``origin`` (3,) with ``normal`` (3,) cuts ``edges`` (E, 2).
-
-    Args:
-        vertices: (V, 3) float, metres.
-
-    Returns:
-        (n, 2) float64 points in the plane's 2D frame (:func:`plane_basis`), metres.
-    """
-    return _sections(vertices, edges, np.asarray(origin, np.float64)[None], normal)[0]
-
-
 def _sections(vertices: np.ndarray, edges: np.ndarray, origins: np.ndarray,
               normal: np.ndarray) -> list[np.ndarray]:
-    """Section points of parallel planes (shared ``normal``), one (n_i, 2) array each."""
+    """Where parallel planes (through ``origins`` (N, 3), shared ``normal`` (3,)) cut the
+    ``edges`` (E, 2) of a mesh with ``vertices`` (V, 3): one (n_i, 2) float64 array per
+    plane, in the planes' 2D frame (:func:`plane_basis`), metres."""
     n = np.asarray(normal, np.float64)
     n = n / np.linalg.norm(n)
     offsets = origins @ n

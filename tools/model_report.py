@@ -28,6 +28,7 @@ from bodyfit.fitter.body_model import BodyModel, project_shape, rest_shape
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model, model_path
 from bodyfit.fitter.outputs import write_png, write_text
+from bodyfit.fitter.model_build import ModelBuildSettings
 from bodyfit.fitter.population import SEXES, PopulationSampler, ReferenceStats
 from bodyfit.fitter.render import parts_legend, render_parts
 
@@ -123,7 +124,8 @@ def main() -> None:
     measurer = Measurer.from_model(model)
     t0 = time.perf_counter()
     half = args.held_out // 2
-    held_out = PopulationSampler(AnnySource(), measurer).sample(
+    held_out = PopulationSampler(AnnySource(), measurer,
+                                 ModelBuildSettings.of(model).population).sample(
         {"male": half, "female": half}, seed=args.seed)
     held_out_s = time.perf_counter() - t0
 
@@ -135,7 +137,7 @@ def main() -> None:
              f"anny {meta['anny_version']}). The model is built by `fitter model build` "
              "(see `fitter/model_build.py`); this file by `tools/model_report.py`.", "",
              "## Build", "",
-             f"- settings: {meta['settings']}; population: {meta['population_settings']}",
+             f"- settings: {meta['settings']}",
              f"- {model.num_vertices} vertices, {len(model.faces)} triangles, "
              f"{model.num_components} components stored (20 used by default), "
              f"explaining {meta['explained_variance']:.6f} of the population's variance",

@@ -9,6 +9,7 @@ import pytest
 from bodyfit.calib.errors import UserError
 from bodyfit.fitter import model_cache
 from bodyfit.fitter.body_model import BodyModel, project_shape, rest_shape
+from bodyfit.fitter.model_build import ModelBuildSettings
 from bodyfit.fitter.population import PopulationSampler
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "model.md"
@@ -54,7 +55,8 @@ def test_held_out_body_within_documented_error(body_model, anny_source, measurer
     """Bodies the space never saw (another seed) reconstruct with K=20 within the error
     docs/model.md reports (mean over a few bodies; generous factor for so few)."""
     mean_mm, p95_mm = documented_k20_errors()
-    population = PopulationSampler(anny_source, measurer).sample(
+    settings = ModelBuildSettings.of(body_model).population
+    population = PopulationSampler(anny_source, measurer, settings).sample(
         {"male": 2, "female": 2}, seed=987)
     betas = project_shape(body_model, population.vertices, population.joints, 20)
     rebuilt, _ = rest_shape(body_model, betas)

@@ -64,3 +64,13 @@ def test_measure_other_topology_exit_2(body_model, tmp_path, capsys):
     trimesh.creation.box([1, 1, 1]).export(path)
     code, _, err = run(capsys, "measure", str(path))
     assert code == 2 and "another topology" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["model", "build", "--samples", "7"], "--samples"),
+    (["model", "build", "--components", "0"], "--components"),
+    (["demo", "--bodies", "0"], "--bodies"),
+])
+def test_bad_options_are_one_line_exit_2(capsys, argv, message):
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1
