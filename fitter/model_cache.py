@@ -52,5 +52,9 @@ def load_model(build_if_needed: bool = True) -> BodyModel:
     except UserError as exc:
         if not build_if_needed:
             raise
-        logger.warning("%s; building the body model (a few minutes, once)", exc)
+        if path.exists():
+            logger.warning("the cached body model is unusable (%s); rebuilding it", exc)
+        else:
+            logger.warning("no body model cached at %s yet; building it (a few minutes, "
+                           "once)", path)
     return build_and_save()
