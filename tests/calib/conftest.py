@@ -1,4 +1,4 @@
-"""Shared fixtures: board photos rendered through a known camera."""
+"""Shared fixtures: board photos rendered through a known camera, and a CLI runner."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import cv2
 import numpy as np
 import pytest
 from bodyfit.calib.boards import BoardSpec, parse_board, render_board
+from bodyfit.calib.cli import main
 from bodyfit.calib.synthetic import BoardPhotoRenderer, bend_photo, random_board_poses
 
 # A phone-like camera: 1280x720, about 63 degrees across, off-centre principal point,
@@ -64,3 +65,21 @@ def charuco_shots(tmp_path_factory) -> BoardShots:
     spec = parse_board("charuco:11x8", 20.0, 15.0, "DICT_5X5_100")
     return _shoot(tmp_path_factory.mktemp("charuco"), spec, seed=2)
 
+
+@dataclass(frozen=True)
+class CliResult:
+    code: int
+    stdout: str
+    stderr: str
+
+
+@pytest.fixture
+def run_calib(capsys):
+    """Run ``calib`` in-process: ``run_calib("capture", ...)`` -> CliResult."""
+
+    def run(*argv: str | Path) -> CliResult:
+        code = main([str(arg) for arg in argv])
+        captured = capsys.readouterr()
+        return CliResult(code, captured.out, captured.err)
+
+    return run
