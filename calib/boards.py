@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from bodyfit.calib.errors import UserError
 from scipy.spatial.distance import pdist
+
+from bodyfit.calib.errors import UserError
 
 __all__ = [
     "BOARD_KINDS",

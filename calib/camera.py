@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
 from bodyfit.calib.boards import BoardSpec
 from bodyfit.calib.errors import UserError
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
 from bodyfit.calib.blur import edge_rise_px
 from bodyfit.calib.boards import BoardDetection, BoardDetector, BoardSpec
 from bodyfit.calib.camera import Camera, camera_fields

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
 from bodyfit.calib.boards import BoardDetector
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+
 from bodyfit.calib.boards import BoardDetector, BoardSpec, parse_board, render_board
 from bodyfit.calib.camera import load_camera
 from bodyfit.calib.capture import (

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+
 from bodyfit.calib.capture import View, ViewStatus
 
 __all__ = ["COVERAGE_GRID", "coverage_fraction", "coverage_picture"]

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+
 from bodyfit.calib.blur import edge_rise_px
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import write_atomic

@@ -42,11 +42,12 @@ from pathlib import Path
 import cv2
 import numpy as np
 import torch
+from kornia.morphology import closing, opening
+
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import read_photo, to_upright
 from bodyfit.calib.undistort import undistort_image
-from kornia.morphology import closing, opening
 
 __all__ = ["SilhouetteSettings", "extract_silhouette", "load_mask", "photo_silhouette"]
 

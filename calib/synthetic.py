@@ -13,12 +13,23 @@ rotation vectors (``rvec``), the board in front of the camera along +z.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from pathlib import Path
 
 import cv2
 import numpy as np
-from bodyfit.calib.boards import BoardPicture
 
-__all__ = ["BoardPhotoRenderer", "bend_photo", "distort_image", "random_board_poses", "source_coordinates"]
+from bodyfit.calib.boards import BoardPicture, BoardSpec, render_board
+
+__all__ = [
+    "BoardPhotoRenderer",
+    "BoardPhotoSet",
+    "bend_photo",
+    "distort_image",
+    "random_board_poses",
+    "source_coordinates",
+    "write_board_photos",
+]
 
 _UNDISTORT_CRITERIA = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-12)
 
@@ -214,3 +225,51 @@ def bend_photo(
     map_x = xs + amplitude_px * np.sin(2 * np.pi * ys / wavelengths_px[0])
     map_y = ys + amplitude_px * np.sin(2 * np.pi * xs / wavelengths_px[1])
     return cv2.remap(photo, map_x, map_y, cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+
+
+@dataclass(frozen=True)
+class BoardPhotoSet:
+    """Grey PNG photos of one board through one camera, written by :func:`write_board_photos`.
+
+    Attributes:
+        spec: the board.
+        sharp: the usable photos, ``view00.png`` ...
+        blurred: the first photo blurred by a 2.5 px Gaussian (edge rise about 6.5 px): too blurry.
+        bent: the second photo through :func:`bend_photo`: corners that fit no camera, an outlier.
+    """
+
+    spec: BoardSpec
+    sharp: list[Path]
+    blurred: Path
+    bent: Path
+
+
+def write_board_photos(
+    folder: Path,
+    spec: BoardSpec,
+    K: np.ndarray,
+    dist: np.ndarray,
+    image_size_px: tuple[int, int],
+    count: int,
+    seed: int,
+    fill_range: tuple[float, float] = (0.3, 0.6),
+) -> BoardPhotoSet:
+    """Photograph ``spec`` from ``count`` random poses (:func:`random_board_poses`) into ``folder``.
+
+    The board is printed at 60 pixels per square; the camera noise is 2 grey levels; the
+    same ``seed`` gives the same photos.
+    """
+    picture = render_board(spec, 60)
+    renderer = BoardPhotoRenderer(picture, K, dist, image_size_px)
+    rng = np.random.default_rng(seed)
+    sharp = []
+    for index, (rvec, tvec) in enumerate(
+        random_board_poses(picture, K, dist, image_size_px, count, rng, fill_range=fill_range)
+    ):
+        path = Path(folder) / f"view{index:02d}.png"
+        cv2.imwrite(str(path), renderer.render(rvec, tvec, rng=rng))
+        sharp.append(path)
+    blurred, bent = Path(folder) / "blurred.png", Path(folder) / "bent.png"
+    cv2.imwrite(str(blurred), cv2.GaussianBlur(cv2.imread(str(sharp[0]), cv2.IMREAD_GRAYSCALE), (0, 0), 2.5))
+    cv2.imwrite(str(bent), bend_photo(cv2.imread(str(sharp[1]), cv2.IMREAD_GRAYSCALE)))
+    return BoardPhotoSet(spec, sharp, blurred, bent)

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 import torch
-from bodyfit.calib.camera import Camera
 from kornia.geometry.calibration import undistort_image as kornia_undistort_image
+
+from bodyfit.calib.camera import Camera
 
 __all__ = ["undistort_image"]
 

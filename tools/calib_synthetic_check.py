@@ -19,11 +19,11 @@ import tempfile
 import time
 from pathlib import Path
 
-import cv2
 import numpy as np
-from bodyfit.calib.boards import BoardSpec, parse_board, render_board
+
+from bodyfit.calib.boards import parse_board
 from bodyfit.calib.cli import main as calib
-from bodyfit.calib.synthetic import BoardPhotoRenderer, bend_photo, random_board_poses
+from bodyfit.calib.synthetic import write_board_photos
 
 BOARDS = {
     "chessboard": (parse_board("chessboard:9x6", 25.0), ["--board", "chessboard:9x6", "--square-mm", "25"]),
@@ -39,23 +39,6 @@ def true_camera(width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     fx = 0.77 * width
     K = np.array([[fx, 0.0, 0.503 * width + 0.3], [0.0, 0.996 * fx, 0.491 * height - 0.2], [0.0, 0.0, 1.0]])
     return K, np.array([-0.11, 0.21, 0.0, 0.0, 0.0])
-
-
-def shoot(folder: Path, spec: BoardSpec, K, dist, size, views: int, seed: int) -> tuple[list[str], float]:
-    """Write ``views`` sharp photos plus blurred.png and warped.png; return paths and seconds taken."""
-    start = time.perf_counter()
-    picture = render_board(spec, 60)
-    renderer = BoardPhotoRenderer(picture, K, dist, size)
-    rng = np.random.default_rng(seed)
-    paths = []
-    for index, (rvec, tvec) in enumerate(random_board_poses(picture, K, dist, size, views, rng, fill_range=(0.3, 0.6))):
-        path = folder / f"view{index:02d}.png"
-        cv2.imwrite(str(path), renderer.render(rvec, tvec, rng=rng))
-        paths.append(str(path))
-    first = cv2.imread(paths[0], cv2.IMREAD_GRAYSCALE)
-    cv2.imwrite(str(folder / "blurred.png"), cv2.GaussianBlur(first, (0, 0), 2.5))
-    cv2.imwrite(str(folder / "warped.png"), bend_photo(cv2.imread(paths[1], cv2.IMREAD_GRAYSCALE)))
-    return [*paths, str(folder / "blurred.png"), str(folder / "warped.png")], time.perf_counter() - start
 
 
 def main() -> None:
@@ -75,7 +58,10 @@ def main() -> None:
     for name, (spec, board_args) in BOARDS.items():
         with tempfile.TemporaryDirectory() as folder:
             folder = Path(folder)
-            paths, render_s = shoot(folder, spec, K, dist, (width, height), args.views, args.seed)
+            start = time.perf_counter()
+            photos = write_board_photos(folder, spec, K, dist, (width, height), args.views, args.seed)
+            render_s = time.perf_counter() - start
+            paths = [str(path) for path in (*photos.sharp, photos.blurred, photos.bent)]
             output = folder / "camera.json"
             start = time.perf_counter()
             with contextlib.redirect_stdout(io.StringIO()):  # keep the command's summary out of the table

@@ -1,8 +1,11 @@
 """Synthetic studio photos for the silhouette tests: a person drawn from ellipses and
 polygons (A-pose) on a coloured backdrop with a lighting gradient, a soft shadow and
-sensor noise. The drawing is not anti-aliased, so the person's pixels are known exactly."""
+sensor noise. The drawing is not anti-aliased, so the person's pixels are known exactly.
+Also the EXIF block with which a phone marks a photo stored sideways."""
 
 from __future__ import annotations
+
+import struct
 
 import cv2
 import numpy as np
@@ -12,6 +15,14 @@ SHIRT = (60, 60, 200)
 TROUSERS = (90, 70, 50)
 SHOES = (30, 30, 30)
 BACKDROP = (175, 150, 70)  # a teal-blue studio backdrop, BGR
+
+
+def exif_with_orientation(orientation: int, byte_order: str) -> np.ndarray:
+    """A minimal TIFF-structured EXIF block holding only the Orientation tag."""
+    mark = b"II" if byte_order == "<" else b"MM"
+    block = mark + struct.pack(byte_order + "HI", 42, 8) + struct.pack(byte_order + "H", 1)
+    block += struct.pack(byte_order + "HHIHH", 0x0112, 3, 1, orientation, 0) + struct.pack(byte_order + "I", 0)
+    return np.frombuffer(block, np.uint8)
 
 
 def _limb(start, end, width: float) -> np.ndarray:

@@ -5,12 +5,13 @@ import math
 import cv2
 import numpy as np
 import pytest
+
 from bodyfit.calib.blur import edge_rise_px
 
 
 @pytest.fixture(scope="module")
 def board_photo(chessboard_shots):
-    photo = cv2.imread(str(chessboard_shots.paths[3]), cv2.IMREAD_GRAYSCALE)
+    photo = cv2.imread(str(chessboard_shots.sharp[3]), cv2.IMREAD_GRAYSCALE)
     found, corners = cv2.findChessboardCornersSB(photo, (9, 6), flags=cv2.CALIB_CB_NORMALIZE_IMAGE)
     assert found
     return photo, corners

@@ -3,6 +3,7 @@
 import cv2
 import numpy as np
 import pytest
+
 from bodyfit.calib.boards import BoardDetector, BoardSpec, parse_board, render_board
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.synthetic import BoardPhotoRenderer

@@ -5,11 +5,13 @@ import json
 import cv2
 import numpy as np
 import pytest
+
 from bodyfit.calib.boards import BoardDetector, parse_board
 from bodyfit.calib.camera import load_camera
 from bodyfit.calib.undistort import undistort_image
+
 from calib_scenes import clutter, iou, studio_photo
-from conftest import IMAGE_SIZE, TRUE_DIST, TRUE_K
+from calib_true_camera import IMAGE_SIZE, TRUE_DIST, TRUE_K
 
 CHESSBOARD = ("--board", "chessboard:9x6", "--square-mm", "25")
 
@@ -21,7 +23,7 @@ def calibrated(tmp_path_factory, chessboard_shots):
 
     folder = tmp_path_factory.mktemp("capture")
     output = folder / "camera.json"
-    inputs = [str(p) for p in chessboard_shots.paths[:9]] + [str(chessboard_shots.blurred)]
+    inputs = [str(p) for p in chessboard_shots.sharp[:9]] + [str(chessboard_shots.blurred)]
     assert main(["capture", *inputs, *CHESSBOARD, "-o", str(output)]) == 0
     return output, inputs
 
@@ -53,8 +55,8 @@ def test_capture_writes_camera_json_with_its_provenance(calibrated):
 def test_capture_prints_the_summary(chessboard_shots, tmp_path, run_calib):
     result = run_calib(
         "capture",
-        *chessboard_shots.paths[:5],
-        chessboard_shots.warped,
+        *chessboard_shots.sharp[:5],
+        chessboard_shots.bent,
         *CHESSBOARD,
         "-o",
         tmp_path / "cam.json",
@@ -73,7 +75,7 @@ def test_capture_prints_the_summary(chessboard_shots, tmp_path, run_calib):
 
 def test_check_reports_the_error_on_held_out_photos(calibrated, chessboard_shots, run_calib):
     output, _ = calibrated
-    held_out = chessboard_shots.paths[9:]
+    held_out = chessboard_shots.sharp[9:]
     result = run_calib("check", output, *held_out)
     assert result.code == 0, result.stderr
     lines = result.stdout.splitlines()
@@ -85,7 +87,7 @@ def test_check_reports_the_error_on_held_out_photos(calibrated, chessboard_shots
 
 def test_undistort_writes_the_kornia_result(calibrated, chessboard_shots, tmp_path, run_calib):
     output, _ = calibrated
-    photo = chessboard_shots.paths[4]
+    photo = chessboard_shots.sharp[4]
     result = run_calib("undistort", output, photo, "-o", tmp_path)
     assert result.code == 0, result.stderr
     written = cv2.imread(str(tmp_path / photo.name))
@@ -155,8 +157,8 @@ def bad_inputs(tmp_path, chessboard_shots):
         "two": _write(
             tmp_path / "two.png", studio_photo((720, 960), [(165.0, 100.0, 500.0), (555.0, 120.0, 500.0)], rng)[0]
         ),
-        "view": chessboard_shots.paths[0],
-        "view2": chessboard_shots.paths[1],
+        "view": chessboard_shots.sharp[0],
+        "view2": chessboard_shots.sharp[1],
     }
     inputs["junk"].write_bytes(b"\xff\xd8 this is not a JPEG")
     inputs["corrupt_camera"].write_text('{"image_size_px": [1280, 720], "K": [[1050, 0, 648')

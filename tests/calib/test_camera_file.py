@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+
 from bodyfit.calib.boards import parse_board
 from bodyfit.calib.camera import Camera, camera_fields, load_camera
 from bodyfit.calib.errors import UserError

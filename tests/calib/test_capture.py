@@ -5,6 +5,7 @@ import dataclasses
 import cv2
 import numpy as np
 import pytest
+
 from bodyfit.calib.boards import BoardDetector, render_board
 from bodyfit.calib.capture import (
     CaptureSettings,
@@ -15,7 +16,8 @@ from bodyfit.calib.capture import (
 )
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.synthetic import BoardPhotoRenderer, random_board_poses
-from conftest import IMAGE_SIZE, TRUE_DIST, TRUE_K
+
+from calib_true_camera import IMAGE_SIZE, TRUE_DIST, TRUE_K
 
 SETTINGS = CaptureSettings()
 
@@ -45,8 +47,8 @@ def assert_recovers_true_camera(calibration):
 @pytest.mark.parametrize("board", ["chessboard_shots", "charuco_shots"])
 def test_recovers_the_camera_from_rendered_photos(request, board):
     shots = request.getfixturevalue(board)
-    calibration = solve(shots, shots.paths)
-    assert len(calibration.used_views) == len(shots.paths)
+    calibration = solve(shots, shots.sharp)
+    assert len(calibration.used_views) == len(shots.sharp)
     assert calibration.rms_px < 0.15
     assert_recovers_true_camera(calibration)
     assert calibration.camera.board == shots.spec and calibration.camera.image_size_px == IMAGE_SIZE
@@ -54,19 +56,19 @@ def test_recovers_the_camera_from_rendered_photos(request, board):
 
 def test_rejects_a_blurred_view_and_an_outlier_and_still_recovers(chessboard_shots):
     shots = chessboard_shots
-    calibration = solve(shots, [*shots.paths, shots.blurred, shots.warped])
+    calibration = solve(shots, [*shots.sharp, shots.blurred, shots.bent])
     status = {view.source: view for view in calibration.views}
     assert status[str(shots.blurred)].status is ViewStatus.BLURRY
     assert status[str(shots.blurred)].edge_rise_px > SETTINGS.max_edge_rise_px
-    assert status[str(shots.warped)].status is ViewStatus.OUTLIER
-    assert status[str(shots.warped)].error_px > 1.0
-    assert describe_views(calibration.views) == f"{len(shots.paths)} used, 2 rejected (1 too blurry, 1 outlier)"
+    assert status[str(shots.bent)].status is ViewStatus.OUTLIER
+    assert status[str(shots.bent)].error_px > 1.0
+    assert describe_views(calibration.views) == f"{len(shots.sharp)} used, 2 rejected (1 too blurry, 1 outlier)"
     assert calibration.worst_view.error_px < 0.2
     assert_recovers_true_camera(calibration)
 
 
 def test_a_richer_model_reports_its_extra_coefficients(charuco_shots):
-    calibration = solve(charuco_shots, charuco_shots.paths, CaptureSettings(model="k1k2p1p2k3"))
+    calibration = solve(charuco_shots, charuco_shots.sharp, CaptureSettings(model="k1k2p1p2k3"))
     assert set(calibration.std) == {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"}
     p1, p2 = calibration.camera.dist[2:4]
     assert abs(p1) < 3 * calibration.std["p1"] + 1e-4 and abs(p2) < 3 * calibration.std["p2"] + 1e-4
@@ -77,7 +79,7 @@ def test_too_few_usable_views_is_a_user_error(chessboard_shots):
     with pytest.raises(
         UserError, match=r"only 2 usable views, the solve needs at least 3 \(2 used, 1 rejected \(1 too blurry\)\)"
     ):
-        solve(shots, [shots.paths[2], shots.paths[3], shots.blurred])
+        solve(shots, [shots.sharp[2], shots.sharp[3], shots.blurred])
 
 
 def test_no_board_anywhere_is_a_user_error(tmp_path, chessboard_shots):

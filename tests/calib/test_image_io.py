@@ -1,10 +1,9 @@
 """Reading photos in the sensor frame, EXIF orientation, video sampling, atomic writes."""
 
-import struct
-
 import cv2
 import numpy as np
 import pytest
+
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import write_atomic
 from bodyfit.calib.images import (
@@ -15,13 +14,7 @@ from bodyfit.calib.images import (
     write_image,
 )
 
-
-def exif_with_orientation(orientation: int, byte_order: str) -> np.ndarray:
-    """A minimal TIFF-structured EXIF block holding only the Orientation tag."""
-    mark = b"II" if byte_order == "<" else b"MM"
-    block = mark + struct.pack(byte_order + "HI", 42, 8) + struct.pack(byte_order + "H", 1)
-    block += struct.pack(byte_order + "HHIHH", 0x0112, 3, 1, orientation, 0) + struct.pack(byte_order + "I", 0)
-    return np.frombuffer(block, np.uint8)
+from calib_scenes import exif_with_orientation
 
 
 @pytest.fixture(scope="module")

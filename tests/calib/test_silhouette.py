@@ -3,6 +3,7 @@
 import cv2
 import numpy as np
 import pytest
+
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.silhouette import (
@@ -13,8 +14,8 @@ from bodyfit.calib.silhouette import (
 )
 from bodyfit.calib.synthetic import distort_image
 from bodyfit.calib.undistort import undistort_image
-from calib_scenes import BACKDROP, clutter, iou, studio_photo
-from test_image_io import exif_with_orientation
+
+from calib_scenes import BACKDROP, clutter, exif_with_orientation, iou, studio_photo
 
 SIZE = (720, 960)  # portrait, width x height
 PERSON = (360.0, 60.0, 820.0)  # centre x, top y, height, pixels

@@ -3,12 +3,14 @@
 import cv2
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
+
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.synthetic import distort_image
 from bodyfit.calib.undistort import undistort_image
-from conftest import IMAGE_SIZE, TRUE_DIST, TRUE_K
-from scipy.spatial import cKDTree
+
+from calib_true_camera import IMAGE_SIZE, TRUE_DIST, TRUE_K
 
 CAMERA = Camera(IMAGE_SIZE, TRUE_K, TRUE_DIST)
 WIDTH, HEIGHT = IMAGE_SIZE
