@@ -8,6 +8,7 @@ import pytest
 
 from bodyfit.calib.boards import BoardDetector, render_board
 from bodyfit.calib.capture import (
+    DISTORTION_MODELS,
     CaptureSettings,
     ViewStatus,
     calibrate,
@@ -87,6 +88,12 @@ def test_no_board_anywhere_is_a_user_error(tmp_path, chessboard_shots):
     cv2.imwrite(str(blank), np.full((IMAGE_SIZE[1], IMAGE_SIZE[0]), 128, np.uint8))
     with pytest.raises(UserError, match="no board found in any of the 2 views"):
         solve(chessboard_shots, [blank, blank])
+
+
+def test_no_model_enables_the_tilted_sensor():
+    # In OpenCV 5.0.0.93 CALIB_DISABLE_SCHUR_COMPLEMENT == CALIB_TILTED_MODEL: passing it adds tilt terms.
+    for flags, _ in DISTORTION_MODELS.values():
+        assert not flags & cv2.CALIB_TILTED_MODEL
 
 
 def test_unknown_model_is_a_user_error():
