@@ -1,3 +1,320 @@
-"""`calib` command line (placeholder replaced below)."""
-def main(argv=None):
+"""The ``calib`` command: calibrate a phone camera, undistort photos, extract silhouettes.
+
+Units: board sizes in millimetres, image measurements in pixels. Bad input ends with one
+line ``calib: error: ...`` on stderr and exit code 2; outputs are written atomically, so
+a failed command leaves no half-written file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import importlib.metadata
+import json
+import logging
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from bodyfit.calib.boards import BoardDetector, BoardSpec, parse_board, render_board
+from bodyfit.calib.camera import load_camera
+from bodyfit.calib.capture import (
+    DISTORTION_MODELS,
+    INTRINSIC_NAMES,
+    CaptureSettings,
+    calibrate,
+    collect_views,
+    describe_views,
+)
+from bodyfit.calib.check import check_calibration
+from bodyfit.calib.coverage import coverage_fraction, coverage_picture
+from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import check_writable_dir, write_atomic
+from bodyfit.calib.images import encode_image, read_photo, to_upright, write_image
+from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
+from bodyfit.calib.undistort import undistort_image
+
+__all__ = ["main"]
+
+_DEFAULTS = CaptureSettings()
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports usage errors in one line, like every other calib error."""
+
+    def error(self, message: str) -> None:  # noqa: D102 - argparse's hook
+        self.exit(2, f"calib: error: {message} (see `{self.prog} --help`)\n")
+
+
+def _version() -> str:
+    try:
+        return importlib.metadata.version("bodyfit")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
+def _add_board_arguments(parser: argparse.ArgumentParser, required: bool) -> None:
+    parser.add_argument(
+        "--board",
+        required=required,
+        metavar="KIND:COLSxROWS",
+        help="chessboard:COLSxROWS counts inner corners (e.g. chessboard:9x6); "
+        "charuco:COLSxROWS counts squares (e.g. charuco:11x8)",
+    )
+    parser.add_argument("--square-mm", type=float, metavar="MM", help="side of one square as printed, millimetres")
+    parser.add_argument("--marker-mm", type=float, metavar="MM", help="charuco only: side of one marker, millimetres")
+    parser.add_argument(
+        "--dict", dest="dictionary", metavar="NAME", help="charuco only: ArUco dictionary, e.g. DICT_5X5_100"
+    )
+
+
+def _board(args: argparse.Namespace) -> BoardSpec:
+    if args.square_mm is None:
+        raise UserError("--board needs --square-mm (the printed square's side in millimetres)")
+    return parse_board(args.board, args.square_mm, args.marker_mm, args.dictionary)
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="calib",
+        description="Calibrate a phone camera, undistort photos, extract silhouettes. "
+        "Board sizes in millimetres, image measures in pixels.",
+    )
+    parser.add_argument("--version", action="version", version=f"bodyfit {_version()}")
+    parser.add_argument("-v", "--verbose", action="store_true", help="log every step to stderr")
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    capture = commands.add_parser(
+        "capture",
+        help="calibrate a camera from board photos and/or videos",
+        description="Calibrate a camera from photos and/or videos of a printed board; writes camera.json "
+        "and a coverage picture. Board sizes in millimetres, errors in pixels.",
+    )
+    capture.add_argument("inputs", nargs="+", metavar="INPUT", help="board photos and/or videos (.mp4, .mov, ...)")
+    _add_board_arguments(capture, required=True)
+    capture.add_argument("-o", "--output", required=True, metavar="camera.json", help="camera file to write")
+    capture.add_argument("--coverage", metavar="PNG", help="coverage picture (default: <output stem>_coverage.png)")
+    capture.add_argument(
+        "--model",
+        choices=list(DISTORTION_MODELS),
+        default=_DEFAULTS.model,
+        help=f"distortion coefficients to estimate (default {_DEFAULTS.model}: radial k1, k2, as in the paper)",
+    )
+    capture.add_argument(
+        "--max-blur-px",
+        type=float,
+        default=_DEFAULTS.max_edge_rise_px,
+        metavar="PX",
+        help="reject views whose board edges take more than PX pixels to rise from 10%% to 90%% "
+        f"(default {_DEFAULTS.max_edge_rise_px})",
+    )
+    capture.add_argument(
+        "--min-views",
+        type=int,
+        default=_DEFAULTS.min_views,
+        metavar="N",
+        help=f"fewest usable views to accept (default {_DEFAULTS.min_views}; 10-20 make a good calibration)",
+    )
+    capture.add_argument(
+        "--video-frames",
+        type=int,
+        default=_DEFAULTS.video_max_frames,
+        metavar="N",
+        help="frames to sample from each video, the sharpest of N equal stretches "
+        f"(default {_DEFAULTS.video_max_frames})",
+    )
+
+    check = commands.add_parser(
+        "check",
+        help="reprojection error of a calibration on held-out board photos",
+        description="Reprojection error (pixels) of camera.json on board photos it was not solved from. "
+        "Uses the board recorded in camera.json unless --board is given.",
+    )
+    check.add_argument("camera", metavar="camera.json")
+    check.add_argument("inputs", nargs="+", metavar="IMAGE", help="held-out board photos and/or videos")
+    _add_board_arguments(check, required=False)
+
+    undistort = commands.add_parser(
+        "undistort",
+        help="remove lens distortion from photos",
+        description="Undistort photos with camera.json (kornia); writes upright images of the same name into DIR.",
+    )
+    undistort.add_argument("camera", metavar="camera.json")
+    undistort.add_argument("inputs", nargs="+", metavar="IMAGE")
+    undistort.add_argument("-o", "--output-dir", required=True, metavar="DIR", help="folder for the undistorted photos")
+
+    silhouette = commands.add_parser(
+        "silhouette",
+        help="the person's mask in a photo on a plain backdrop",
+        description="Extract the person's silhouette from a photo on a plain backdrop; writes a black/white PNG "
+        "of the undistorted (with --camera), upright photo.",
+    )
+    silhouette.add_argument("photo", metavar="PHOTO")
+    silhouette.add_argument("--camera", metavar="camera.json", help="undistort the silhouette with this camera")
+    silhouette.add_argument("--background", metavar="PLATE", help="background plate: the same view without the person")
+    silhouette.add_argument("-o", "--output", required=True, metavar="mask.png")
+
+    board = commands.add_parser(
+        "board",
+        help="draw a board to print",
+        description="Draw a calibration board as a PNG. Print it at 100%% scale at --dpi, glue it flat, "
+        "and measure a square: pass the measured side as --square-mm.",
+    )
+    _add_board_arguments(board, required=True)
+    board.add_argument("--dpi", type=float, default=300.0, help="print resolution, dots per inch (default 300)")
+    board.add_argument("-o", "--output", required=True, metavar="board.png")
+    return parser
+
+
+def _capture(args: argparse.Namespace, argv: list[str]) -> None:
+    spec = _board(args)
+    settings = CaptureSettings(
+        model=args.model,
+        max_edge_rise_px=args.max_blur_px,
+        min_views=args.min_views,
+        video_max_frames=args.video_frames,
+    )
+    output = Path(args.output)
+    coverage_path = Path(args.coverage) if args.coverage else output.with_name(f"{output.stem}_coverage.png")
+    check_writable_dir(output.parent)
+    check_writable_dir(coverage_path.parent)
+
+    views, image_size = collect_views(args.inputs, BoardDetector(spec), settings)
+    calibration = calibrate(views, image_size, settings, spec)
+    covered = coverage_fraction(list(calibration.views), image_size)
+    record = {
+        **calibration.to_record(),
+        "coverage_fraction": covered,
+        "provenance": {
+            "argv": argv,
+            "inputs": list(args.inputs),
+            "bodyfit_version": _version(),
+            "opencv_version": cv2.__version__,
+            "time": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        },
+    }
+    write_image(coverage_path, coverage_picture(list(calibration.views), image_size))
+    write_atomic(output, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
+
+    print(f"board: {spec.describe()}; images {image_size[0]}x{image_size[1]} px")
+    for view in calibration.views:
+        detail = view.status.value
+        if view.error_px is not None:
+            detail += f"  error {view.error_px:.3f} px"
+        if view.edge_rise_px is not None:
+            detail += f"  edge rise {view.edge_rise_px:.1f} px"
+        print(f"  {view.name}: {detail}")
+    worst = calibration.worst_view
+    print(f"views: {describe_views(calibration.views)}")
+    print(f"RMS reprojection error {calibration.rms_px:.3f} px; worst view {worst.name} {worst.error_px:.3f} px")
+    print(f"coverage: corners in {covered:.0%} of the frame's grid cells (see {coverage_path})")
+    print(f"intrinsics, model {settings.model} (value ± standard deviation):")
+    K, dist = calibration.camera.K, calibration.camera.dist
+    values = dict(zip(INTRINSIC_NAMES, (K[0, 0], K[1, 1], K[0, 2], K[1, 2], *dist)))
+    for name, std in calibration.std.items():
+        unit = " px" if name in ("fx", "fy", "cx", "cy") else ""
+        digits = 2 if unit else 4
+        print(f"  {name} = {values[name]:.{digits}f} ± {std:.{digits}f}{unit}")
+    print(f"wrote {output}")
+    print(f"wrote {coverage_path}")
+
+
+def _check(args: argparse.Namespace) -> None:
+    camera = load_camera(args.camera)
+    if args.board is not None:
+        spec = _board(args)
+    elif camera.board is not None:
+        spec = camera.board
+    else:
+        raise UserError(f"{args.camera} records no board; give --board and --square-mm")
+    views, rms = check_calibration(camera, args.inputs, BoardDetector(spec))
+    for view in views:
+        if view.error_px is not None:
+            print(f"  {view.name}: error {view.error_px:.3f} px ({view.corners} corners)")
+        else:
+            print(f"  {view.name}: {'no board' if view.corners == 0 else 'pose not found'}")
+    found = sum(view.error_px is not None for view in views)
+    print(f"held-out RMS reprojection error {rms:.3f} px over {found} of {len(views)} views")
+    if camera.rms_px is not None:
+        print(f"calibration RMS reprojection error {camera.rms_px:.3f} px")
+
+
+def _undistort(args: argparse.Namespace) -> None:
+    camera = load_camera(args.camera)
+    folder = check_writable_dir(args.output_dir)
+    targets = [folder / Path(path).name for path in args.inputs]
+    if len(set(targets)) < len(targets):
+        raise UserError("two inputs share a file name; they would overwrite each other in the output folder")
+    for path, target in zip(args.inputs, targets):
+        if target.exists() and target.resolve() == Path(path).resolve():
+            raise UserError(f"{path} would be overwritten; choose another output folder")
+    # Undistort everything before writing anything: a bad input fails the whole command cleanly.
+    payloads = []
+    for path, target in zip(args.inputs, targets):
+        photo = read_photo(path)
+        undistorted = to_upright(undistort_image(photo.pixels, camera, path), photo.orientation)
+        payloads.append((target, encode_image(undistorted, target.suffix)))
+    for target, payload in payloads:
+        write_atomic(target, payload)
+        print(f"wrote {target}")
+
+
+def _silhouette(args: argparse.Namespace) -> None:
+    output = Path(args.output)
+    check_writable_dir(output.parent)
+    camera = load_camera(args.camera) if args.camera else None
+    mask = photo_silhouette(args.photo, camera, args.background, SilhouetteSettings())
+    rows = np.flatnonzero(mask.any(axis=1))
+    write_image(output, mask.astype(np.uint8) * 255)
+    print(
+        f"silhouette: {int(mask.sum())} pixels, {rows[-1] - rows[0] + 1} px tall, in a "
+        f"{mask.shape[1]}x{mask.shape[0]} image{' (undistorted)' if camera else ''}"
+    )
+    print(f"wrote {output}")
+
+
+def _draw_board(args: argparse.Namespace) -> None:
+    spec = _board(args)
+    if not args.dpi > 0:
+        raise UserError(f"--dpi must be positive, got {args.dpi}")
+    pixels_per_square = round(spec.square_mm / 25.4 * args.dpi)
+    picture = render_board(spec, pixels_per_square)
+    write_image(args.output, picture.image)
+    height, width = picture.image.shape
+    print(
+        f"{spec.describe()}: {width}x{height} px; printed at {args.dpi:g} dpi and 100 % scale it is "
+        f"{width / args.dpi * 25.4:.0f} x {height / args.dpi * 25.4:.0f} mm with "
+        f"{pixels_per_square / args.dpi * 25.4:.2f} mm squares"
+    )
+    print(f"wrote {args.output}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run ``calib`` with ``argv`` (default: the process's arguments); returns the exit code."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        args = _build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help, --version, usage errors: argparse has printed its message
+        return int(stop.code or 0)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s: %(message)s")
+    try:
+        if args.command == "capture":
+            _capture(args, ["calib", *argv])
+        elif args.command == "check":
+            _check(args)
+        elif args.command == "undistort":
+            _undistort(args)
+        elif args.command == "silhouette":
+            _silhouette(args)
+        else:
+            _draw_board(args)
+    except UserError as error:
+        print(f"calib: error: {error}", file=sys.stderr)
+        return 2
     return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

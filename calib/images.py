@@ -1,0 +1,232 @@
+"""Reading photos and video frames, and writing images, in one consistent pixel frame.
+
+EXIF orientation: a phone stores every photo in its *sensor* pixel layout and records
+how to turn it upright in the EXIF Orientation tag. The camera matrix describes the
+sensor layout, so every image is read with ``cv2.IMREAD_IGNORE_ORIENTATION`` (and
+videos with ``CAP_PROP_ORIENTATION_AUTO`` off): calibration, undistortion and
+silhouette extraction all happen in the sensor frame, and portrait and landscape shots
+of one phone share one camera.json. Only images made for people or for the fitter
+(undistorted photos, masks) are turned upright at the end with :func:`to_upright`,
+using the tag :func:`read_photo` returns.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import struct
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from bodyfit.calib.blur import edge_rise_px
+from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import write_atomic
+
+__all__ = [
+    "VIDEO_SUFFIXES",
+    "Photo",
+    "encode_image",
+    "frame_name",
+    "is_video",
+    "read_frames",
+    "read_photo",
+    "sample_video_frames",
+    "to_upright",
+    "write_image",
+]
+
+log = logging.getLogger(__name__)
+
+VIDEO_SUFFIXES = frozenset({".mp4", ".mov", ".m4v", ".avi", ".mkv", ".webm", ".mts", ".3gp"})
+
+_EXIF_ORIENTATION_TAG = 0x0112
+# Frames are ranked for sharpness at this width; the ranking only compares frames of one clip.
+_RANKING_WIDTH_PX = 640
+
+
+@dataclass(frozen=True)
+class Photo:
+    """A photo as the sensor recorded it.
+
+    Attributes:
+        pixels: (H, W, 3) uint8, BGR, sensor frame (EXIF orientation not applied).
+        orientation: EXIF Orientation tag, 1..8 (1 when the file has none).
+    """
+
+    pixels: np.ndarray
+    orientation: int
+
+
+def _exif_orientation(exif: bytes) -> int:
+    """The Orientation tag (1..8) of a TIFF-structured EXIF block, 1 if absent or malformed."""
+    if exif.startswith(b"Exif\x00\x00"):
+        exif = exif[6:]
+    if len(exif) < 8 or exif[:2] not in (b"II", b"MM"):
+        return 1
+    order = "<" if exif[:2] == b"II" else ">"
+    (first_directory,) = struct.unpack_from(order + "I", exif, 4)
+    if first_directory + 2 > len(exif):
+        return 1
+    (entries,) = struct.unpack_from(order + "H", exif, first_directory)
+    for index in range(entries):
+        entry = first_directory + 2 + 12 * index
+        if entry + 12 > len(exif):
+            break
+        tag, value_type = struct.unpack_from(order + "HH", exif, entry)
+        if tag == _EXIF_ORIENTATION_TAG and value_type == 3:  # 3 = SHORT
+            (value,) = struct.unpack_from(order + "H", exif, entry + 8)
+            return value if 1 <= value <= 8 else 1
+    return 1
+
+
+def read_photo(path: str | Path) -> Photo:
+    """Read a photo in the sensor frame, with its EXIF orientation; UserError if unreadable."""
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(f"{path}: no such file")
+    pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), cv2.IMREAD_COLOR | cv2.IMREAD_IGNORE_ORIENTATION)
+    if pixels is None or pixels.size == 0:
+        raise UserError(f"{path}: not a readable image (OpenCV cannot decode it)")
+    orientation = 1
+    for kind, block in zip(np.asarray(kinds).reshape(-1), blocks):
+        if kind == cv2.IMAGE_METADATA_EXIF:
+            orientation = _exif_orientation(np.asarray(block, np.uint8).tobytes())
+    return Photo(pixels, orientation)
+
+
+def to_upright(image: np.ndarray, orientation: int) -> np.ndarray:
+    """Turn a sensor-frame image upright as its EXIF ``orientation`` (1..8) says.
+
+    Works on any (H, W, ...) array (photos, masks); matches what ``cv2.imread`` does by
+    default with the same tag.
+    """
+    if orientation == 1:
+        return image
+    if orientation == 2:
+        return cv2.flip(image, 1)
+    if orientation == 3:
+        return cv2.rotate(image, cv2.ROTATE_180)
+    if orientation == 4:
+        return cv2.flip(image, 0)
+    if orientation == 5:
+        return cv2.transpose(image)
+    if orientation == 6:
+        return cv2.rotate(image, cv2.ROTATE_90_CLOCKWISE)
+    if orientation == 7:
+        return cv2.flip(cv2.transpose(image), -1)
+    if orientation == 8:
+        return cv2.rotate(image, cv2.ROTATE_90_COUNTERCLOCKWISE)
+    raise ValueError(f"EXIF orientation must be 1..8, got {orientation}")
+
+
+def is_video(path: str | Path) -> bool:
+    """Whether ``path`` names a video (by its suffix, one of :data:`VIDEO_SUFFIXES`)."""
+    return Path(path).suffix.lower() in VIDEO_SUFFIXES
+
+
+def sample_video_frames(path: str | Path, max_frames: int) -> Iterator[tuple[int, np.ndarray]]:
+    """The sharpest frame of each of about ``max_frames`` equal stretches of a video.
+
+    Yields (frame_index, (H, W, 3) uint8 BGR sensor-frame frame) in time order. The
+    stretches are the clip split evenly by frame count (one per second when the
+    container does not say how many frames it holds). Raises UserError when the
+    file cannot be opened as a video.
+    """
+    if max_frames < 1:
+        raise ValueError(f"max_frames must be at least 1, got {max_frames}")
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(f"{path}: no such file")
+    capture = cv2.VideoCapture(str(path))
+    try:
+        if not capture.isOpened():
+            raise UserError(f"{path}: not a readable video (OpenCV cannot open it)")
+        capture.set(cv2.CAP_PROP_ORIENTATION_AUTO, 0)
+        frame_count = int(capture.get(cv2.CAP_PROP_FRAME_COUNT))
+        frames_per_second = capture.get(cv2.CAP_PROP_FPS)
+        if frame_count > 0:
+            stretch = max(1, math.ceil(frame_count / max_frames))
+        else:
+            stretch = max(1, round(frames_per_second)) if frames_per_second > 0 else 30
+        best: tuple[float, int, np.ndarray] | None = None
+        index = -1
+        frames_read = 0
+        while True:
+            ok, frame = capture.read()
+            if not ok:
+                break
+            index += 1
+            frames_read += 1
+            if best is not None and index // stretch != best[1] // stretch:
+                yield best[1], best[2]
+                best = None
+            rise = _ranking_rise(frame)
+            if best is None or rise < best[0]:
+                best = (rise, index, frame)
+        if best is not None:
+            yield best[1], best[2]
+        if frames_read == 0:
+            raise UserError(f"{path}: the video holds no frame OpenCV can decode")
+        log.info("%s: %d frames read, stretches of %d frames", path, frames_read, stretch)
+    finally:
+        capture.release()
+
+
+def frame_name(source: str, frame_index: int | None) -> str:
+    """How reports name an input image: ``photo.jpg``, or ``clip.mp4@frame 120`` for a video frame."""
+    return source if frame_index is None else f"{source}@frame {frame_index}"
+
+
+def read_frames(paths: Iterable[str], video_max_frames: int) -> Iterator[tuple[str, int | None, np.ndarray]]:
+    """(source, frame_index, (H, W, 3) uint8 BGR sensor-frame image) for every input.
+
+    A photo gives one image (frame_index None), a video its sampled frames
+    (:func:`sample_video_frames`). All images must have one size: UserError names the
+    first that differs.
+    """
+    first: tuple[tuple[int, int], str] | None = None
+    for path in paths:
+        frames = sample_video_frames(path, video_max_frames) if is_video(path) else [(None, read_photo(path).pixels)]
+        for frame_index, image in frames:
+            size = (image.shape[1], image.shape[0])
+            if first is None:
+                first = (size, path)
+            elif size != first[0]:
+                raise UserError(
+                    f"{path} is {size[0]}x{size[1]} pixels but {first[1]} is {first[0][0]}x{first[0][1]}; "
+                    "the images must all have one size (a phone's photos and videos often differ: "
+                    "use them separately)"
+                )
+            yield path, frame_index, image
+
+
+def _ranking_rise(frame: np.ndarray) -> float:
+    gray = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    if gray.shape[1] > _RANKING_WIDTH_PX:
+        height = round(gray.shape[0] * _RANKING_WIDTH_PX / gray.shape[1])
+        gray = cv2.resize(gray, (_RANKING_WIDTH_PX, height), interpolation=cv2.INTER_AREA)
+    return edge_rise_px(gray)
+
+
+def encode_image(image: np.ndarray, suffix: str) -> bytes:
+    """Encode ``image`` ((H, W) or (H, W, 3) uint8) in the format named by ``suffix`` (".png", ".jpg", ...).
+
+    JPEG is written at quality 95.
+    """
+    params = [cv2.IMWRITE_JPEG_QUALITY, 95] if suffix.lower() in (".jpg", ".jpeg") else []
+    try:
+        ok, payload = cv2.imencode(suffix, image, params)
+    except cv2.error:
+        ok = False
+    if not ok:
+        raise UserError(f"cannot write a {suffix!r} image; use .png or .jpg")
+    return payload.tobytes()
+
+
+def write_image(path: str | Path, image: np.ndarray) -> None:
+    """Encode ``image`` by the suffix of ``path`` and write it atomically."""
+    write_atomic(path, encode_image(image, Path(path).suffix))

@@ -1,0 +1,374 @@
+"""Silhouettes: the person on a plain backdrop as a binary mask.
+
+Algorithm (background subtraction with a shadow-tolerant colour test, after
+Horprasert, Harwood and Davis, "A statistical approach for real-time robust background
+subtraction and shadow detection", 1999):
+
+1. Backdrop colour E at every pixel: a quadratic surface in (x, y) per BGR channel,
+   fitted robustly to a band along the frame border (which must show only backdrop),
+   so smooth lighting falloff is modelled; or a background plate photo taken from the
+   same spot without the person.
+2. Each pixel I is compared with E by its brightness ratio ``a = I.E / E.E`` and its
+   chroma distortion ``|I - a E|`` (the colour change a shadow cannot explain, in grey
+   levels of 0..255; sensor noise gives it the same spread in light and shadow). A
+   shadow darkens the backdrop without changing its chroma, so pixels of small chroma
+   distortion with ``shadow_min_brightness <= a <= max_highlight_brightness`` are
+   backdrop; the rest is person. The chroma threshold is ``noise_factor`` times the border's median chroma
+   distortion (robust to a little of the person in the border), never below
+   ``min_chroma_distortion``. The threshold sits low, inside the noise's tail, so that
+   clothes close to the backdrop's colour are found; step 3 removes the specks of
+   backdrop noise that this lets through.
+3. A ``median_px`` median filter votes away most noise specks and pinholes; kornia
+   morphology, an opening then a closing with a ``morphology_px`` disc, removes what is
+   left and smooths the outline; the largest 8-connected region is the person.
+4. The low threshold puts the outline where an edge pixel is only slightly person;
+   within ``outline_band_px`` of the outline each pixel is re-decided by its mixing
+   fraction between the local person and backdrop colours, so the outline runs where a
+   blurred or anti-aliased edge is half and half (on blurred synthetic photos this
+   raises the IoU from 0.96 to 0.997).
+5. Enclosed holes smaller than ``max_hole_fraction`` of the person are filled (larger
+   ones are real gaps, e.g. between an arm and the body with a hand on the hip).
+
+A backdrop that is not plain, a missing person, a person touching the frame edge and
+several people are UserErrors. A backdrop of the clothes' or skin's colour cannot work.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+import torch
+from kornia.morphology import closing, opening
+
+from bodyfit.calib.camera import Camera
+from bodyfit.calib.errors import UserError
+from bodyfit.calib.images import read_photo, to_upright
+from bodyfit.calib.undistort import undistort_image
+
+__all__ = ["SilhouetteSettings", "extract_silhouette", "load_mask", "photo_silhouette"]
+
+log = logging.getLogger(__name__)
+
+_MAX_BORDER_SAMPLES = 40_000
+_SIDE_NAMES = ("top", "bottom", "left", "right")
+
+
+@dataclass(frozen=True)
+class SilhouetteSettings:
+    """Thresholds of :func:`extract_silhouette` (see the module docstring).
+
+    Attributes:
+        border_band_fraction: width of the border band that models the backdrop,
+            fraction of the image's shorter side.
+        min_chroma_distortion: smallest chroma distortion that separates person from
+            backdrop, grey levels (0..255).
+        noise_factor: chroma threshold over the border's median chroma distortion.
+        shadow_min_brightness: backdrop darkened down to this fraction of its modelled
+            brightness still counts as backdrop (a shadow).
+        max_highlight_brightness: backdrop brighter than this fraction of its modelled
+            brightness counts as person (white clothes on a grey backdrop).
+        max_backdrop_chroma_distortion: the border's 95th-percentile chroma distortion
+            above this (grey levels) means the backdrop is not plain.
+        max_border_foreground_fraction: more of the border band than this unlike the
+            backdrop means the backdrop is not plain.
+        median_px: side of the median filter's window, pixels (odd; 1 disables it).
+        morphology_px: diameter of the disc for the opening and closing, pixels.
+        min_person_fraction: the person must cover at least this fraction of the image.
+        max_second_region_ratio: a second region at least this fraction of the largest
+            means several people (or a large object) in the picture.
+        outline_band_px: pixels either side of the outline that step 4 re-decides (0: none).
+        outline_window_px: side of the window for the local person and backdrop colours, pixels.
+        max_hole_fraction: enclosed holes up to this fraction of the person's area are filled.
+    """
+
+    border_band_fraction: float = 0.04
+    min_chroma_distortion: float = 6.0
+    noise_factor: float = 2.5
+    shadow_min_brightness: float = 0.45
+    max_highlight_brightness: float = 1.35
+    max_backdrop_chroma_distortion: float = 25.0
+    max_border_foreground_fraction: float = 0.25
+    median_px: int = 3
+    morphology_px: int = 3
+    min_person_fraction: float = 0.02
+    max_second_region_ratio: float = 0.15
+    outline_band_px: int = 2
+    outline_window_px: int = 11
+    max_hole_fraction: float = 0.01
+
+    def __post_init__(self) -> None:
+        if self.median_px < 1 or self.median_px % 2 == 0:
+            raise ValueError(f"median_px must be odd and positive, got {self.median_px}")
+        if self.morphology_px < 1:
+            raise ValueError(f"morphology_px must be positive, got {self.morphology_px}")
+
+
+def _border_band(shape: tuple[int, int], fraction: float) -> np.ndarray:
+    """(H, W) bool, True in a band of ``fraction`` x the shorter side along the edges."""
+    height, width = shape
+    width_px = max(2, round(fraction * min(height, width)))
+    band = np.ones(shape, bool)
+    band[width_px:-width_px, width_px:-width_px] = False
+    return band
+
+
+def _quadratic_terms(x: np.ndarray, y: np.ndarray) -> list[np.ndarray]:
+    return [np.ones_like(x * y), x, y, x * x, x * y, y * y]
+
+
+def _fit_backdrop(image: np.ndarray, band: np.ndarray) -> np.ndarray:
+    """(H, W, 3) float32 modelled backdrop colour, a robust quadratic fit to the band."""
+    height, width = band.shape
+    rows, cols = np.nonzero(band)
+    stride = max(1, len(rows) // _MAX_BORDER_SAMPLES)
+    rows, cols = rows[::stride], cols[::stride]
+    x, y = cols / (width - 1) * 2 - 1, rows / (height - 1) * 2 - 1
+    design = np.stack(_quadratic_terms(x, y), axis=1)
+    colours = image[rows, cols].astype(np.float64)
+    inliers = np.ones(len(rows), bool)
+    for _ in range(4):
+        coefficients, *_ = np.linalg.lstsq(design[inliers], colours[inliers], rcond=None)
+        residual = np.linalg.norm(colours - design @ coefficients, axis=1)
+        inliers = residual <= 3.0 * max(float(np.median(residual)), 1.0)
+    grid_x = (np.arange(width, dtype=np.float32) / (width - 1) * 2 - 1)[None, :]
+    grid_y = (np.arange(height, dtype=np.float32) / (height - 1) * 2 - 1)[:, None]
+    terms = _quadratic_terms(grid_x, grid_y)
+    backdrop = np.empty((height, width, 3), np.float32)
+    for channel in range(3):
+        backdrop[..., channel] = sum(float(c) * term for c, term in zip(coefficients[:, channel], terms))
+    return backdrop
+
+
+def _compare(image: np.ndarray, backdrop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Brightness ratio and chroma distortion of ``image`` against ``backdrop``.
+
+    Brightness ratio ``a = I.E / E.E`` (unitless); chroma distortion ``|I - a E|``, the
+    colour change a shadow cannot explain, grey levels. Returns two (H, W) float32 arrays.
+    """
+    pixels = image.astype(np.float32)
+    backdrop_sq = np.maximum(np.einsum("hwc,hwc->hw", backdrop, backdrop), 1e-6)
+    brightness = np.einsum("hwc,hwc->hw", pixels, backdrop) / backdrop_sq
+    off_axis = pixels - brightness[..., None] * backdrop
+    distortion = np.sqrt(np.einsum("hwc,hwc->hw", off_axis, off_axis))
+    return brightness, distortion
+
+
+def _clean(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray:
+    """Median filter, then opening and closing with a disc (kornia); (H, W) bool -> (H, W) bool."""
+    if settings.median_px > 1:
+        mask = cv2.medianBlur(mask.astype(np.uint8), settings.median_px) > 0
+    diameter = settings.morphology_px
+    if diameter <= 1:
+        return mask
+    disc = torch.from_numpy(cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (diameter, diameter))).float()
+    tensor = torch.from_numpy(mask.astype(np.float32))[None, None]
+    with torch.inference_mode():
+        cleaned = closing(opening(tensor, disc), disc)
+    return cleaned[0, 0].numpy() > 0.5
+
+
+def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """8-connected regions: (labels (H, W) int32, stats (regions, 5)); stats row i is label i + 1."""
+    _, labels, stats, _ = cv2.connectedComponentsWithStats(mask.astype(np.uint8), connectivity=8)
+    return labels, stats[1:]
+
+
+def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray:
+    """The largest region of ``mask``; UserError if it is no person, not alone or cut by the frame."""
+    height, width = mask.shape
+    labels, stats = _components(mask)
+    areas = stats[:, cv2.CC_STAT_AREA]
+    if len(areas) == 0 or areas.max() < settings.min_person_fraction * height * width:
+        raise UserError(
+            "no person found: nothing in the photo differs from the backdrop over more than "
+            f"{settings.min_person_fraction:.0%} of the image; stand the person in front of the backdrop, "
+            "in clothes that do not match its colour"
+        )
+    largest = int(np.argmax(areas))
+    similar = int(np.sum(areas >= settings.max_second_region_ratio * areas[largest]))
+    if similar > 1:
+        raise UserError(
+            f"{similar} person-sized regions differ from the backdrop; photograph one person at a time, "
+            "with nothing else in front of the backdrop"
+        )
+    left, top, box_width, box_height = stats[largest, :4]
+    edges = (top == 0, top + box_height == height, left == 0, left + box_width == width)
+    touching = [side for side, touches in zip(_SIDE_NAMES, edges) if touches]
+    if touching:
+        raise UserError(
+            f"the person touches the {' and '.join(touching)} edge of the photo; step back so that the "
+            "whole body is inside the frame with backdrop all around it"
+        )
+    return labels == largest + 1
+
+
+def _refine_outline(image: np.ndarray, region: np.ndarray, settings: SilhouetteSettings) -> np.ndarray:
+    """Move the outline to where edge pixels are half person, half backdrop.
+
+    Near the outline a pixel's colour I mixes the person's local colour P and the
+    backdrop's local colour B (each the mean of the confidently inside or outside pixels
+    in a ``outline_window_px`` window, so a shadow next to the person is part of B). The
+    pixel is person when its mixing fraction ``(I - B).(P - B) / |P - B|^2`` is at least
+    one half. Returns the largest region of the result.
+    """
+    pixels = image.astype(np.float32)
+    marked = region.astype(np.uint8)
+    shrink = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * settings.outline_band_px + 1,) * 2)
+    inside = cv2.erode(marked, shrink).astype(bool)
+    outside = cv2.erode(1 - marked, shrink).astype(bool)
+    window = (settings.outline_window_px, settings.outline_window_px)
+
+    def local_mean(selected: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        weight = cv2.boxFilter(selected.astype(np.float32), -1, window, normalize=False)
+        total = cv2.boxFilter(pixels * selected[..., None], -1, window, normalize=False)
+        return total / np.maximum(weight, 1e-6)[..., None], weight
+
+    person_colour, person_weight = local_mean(inside)
+    backdrop_colour, backdrop_weight = local_mean(outside)
+    contrast = person_colour - backdrop_colour
+    fraction = np.einsum("hwc,hwc->hw", pixels - backdrop_colour, contrast) / np.maximum(
+        np.einsum("hwc,hwc->hw", contrast, contrast), 1e-6
+    )
+    band = ~inside & ~outside & (person_weight > 0) & (backdrop_weight > 0)
+    refined = region.copy()
+    refined[band] = fraction[band] >= 0.5
+    labels, stats = _components(refined)
+    return labels == int(np.argmax(stats[:, cv2.CC_STAT_AREA])) + 1
+
+
+def _fill_small_holes(region: np.ndarray, settings: SilhouetteSettings) -> np.ndarray:
+    """Fill enclosed background pieces smaller than ``max_hole_fraction`` of the region."""
+    # 4-connected background, the complement of 8-connected foreground.
+    _, labels, stats, _ = cv2.connectedComponentsWithStats((~region).astype(np.uint8), connectivity=4)
+    small = stats[:, cv2.CC_STAT_AREA] <= settings.max_hole_fraction * region.sum()
+    small[0] = False  # label 0: the region itself (zero in the complement)
+    small[labels[0, 0]] = False  # the backdrop around the person (the region does not touch the frame)
+    return region | small[labels]
+
+
+def extract_silhouette(
+    image_bgr: np.ndarray,
+    background: np.ndarray | None = None,
+    settings: SilhouetteSettings = SilhouetteSettings(),
+) -> np.ndarray:
+    """The person's silhouette in a photo on a plain backdrop.
+
+    Args:
+        image_bgr: (H, W, 3) uint8 BGR photo, any orientation, as recorded or undistorted
+            (the border band must show backdrop, not the black corners undistortion can leave).
+        background: optional (H, W, 3) uint8 BGR background plate: the same view
+            without the person. Without one the backdrop is modelled from the frame border.
+        settings: thresholds.
+
+    Returns:
+        (H, W) bool mask, True on the person.
+
+    Raises:
+        UserError: backdrop not plain (or plate not matching), no person, person
+            touching the frame edge, several people.
+    """
+    if image_bgr.ndim != 3 or image_bgr.shape[2] != 3 or image_bgr.dtype != np.uint8:
+        raise ValueError(
+            f"extract_silhouette() takes an (H, W, 3) uint8 image, got {image_bgr.shape} {image_bgr.dtype}"
+        )
+    band = _border_band(image_bgr.shape[:2], settings.border_band_fraction)
+    if background is None:
+        backdrop = _fit_backdrop(image_bgr, band)
+    else:
+        if background.shape != image_bgr.shape:
+            raise UserError(
+                f"the background plate is {background.shape[1]}x{background.shape[0]} but the photo is "
+                f"{image_bgr.shape[1]}x{image_bgr.shape[0]}; take both with the same camera setting"
+            )
+        backdrop = background.astype(np.float32)
+    brightness, chroma = _compare(image_bgr, backdrop)
+
+    lit = band & (brightness >= settings.shadow_min_brightness) & (brightness <= settings.max_highlight_brightness)
+    lit_chroma = chroma[lit] if lit.any() else np.array([np.inf])
+    chroma_threshold = max(settings.min_chroma_distortion, settings.noise_factor * float(np.median(lit_chroma)))
+    foreground = (
+        (chroma > chroma_threshold)
+        | (brightness < settings.shadow_min_brightness)
+        | (brightness > settings.max_highlight_brightness)
+    )
+    border_foreground = float(foreground[band].mean())
+    chroma_spread = float(np.percentile(lit_chroma, 95))
+    log.info(
+        "backdrop: chroma spread %.1f, threshold %.1f grey levels, %.1f %% of the border unlike it",
+        chroma_spread,
+        chroma_threshold,
+        100 * border_foreground,
+    )
+    if (
+        chroma_spread > settings.max_backdrop_chroma_distortion
+        or border_foreground > settings.max_border_foreground_fraction
+    ):
+        if background is not None:
+            raise UserError(
+                "the background plate does not match the photo around the edges; keep the camera and "
+                "the lights still between the plate and the photo"
+            )
+        raise UserError(
+            f"the backdrop is not plain ({border_foreground:.0%} of the frame border differs from it, colour "
+            f"spread {chroma_spread:.0f} grey levels); use a single-colour backdrop filling the whole frame, "
+            "or give a background plate (--background)"
+        )
+    region = _person_region(_clean(foreground, settings), settings)
+    return _fill_small_holes(_refine_outline(image_bgr, region, settings), settings)
+
+
+def load_mask(path: str | Path) -> np.ndarray:
+    """A user-made silhouette mask: (H, W) bool, True where the PNG is brighter than mid-grey.
+
+    The mask must be of the undistorted, upright photo (e.g. drawn over the output of
+    ``calib undistort``). Raises UserError when it cannot be read or is empty.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise UserError(f"{path}: no such file")
+    pixels = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
+    if pixels is None:
+        raise UserError(f"{path}: not a readable image (OpenCV cannot decode it)")
+    mask = pixels > 127
+    if not mask.any() or mask.all():
+        raise UserError(
+            f"{path}: the mask is all {'white' if mask.all() else 'black'}; the person must be white on black"
+        )
+    return mask
+
+
+def photo_silhouette(
+    photo_path: str | Path,
+    camera: Camera | None = None,
+    background_path: str | Path | None = None,
+    settings: SilhouetteSettings = SilhouetteSettings(),
+) -> np.ndarray:
+    """Silhouette of the person in a photo file, as the fitter needs it.
+
+    The silhouette is extracted from the photo as recorded (sensor frame, so the whole
+    border is real backdrop), then undistorted with ``camera`` when given (bilinear,
+    thresholded at one half: the outline keeps sub-pixel accuracy), then turned upright
+    by the photo's EXIF orientation.
+
+    Args:
+        photo_path: the person's photo.
+        camera: the calibrated camera, or None to skip undistortion.
+        background_path: optional background plate photo (same spot, no person).
+        settings: thresholds.
+
+    Returns:
+        (H', W') bool mask of the undistorted, upright photo.
+    """
+    photo = read_photo(photo_path)
+    if camera is not None:
+        camera.check_image(photo.pixels, str(photo_path))
+    plate = None if background_path is None else read_photo(background_path).pixels
+    mask = extract_silhouette(photo.pixels, plate, settings)
+    if camera is not None:
+        mask = undistort_image(mask.astype(np.float32), camera, str(photo_path)) > 0.5
+    log.info("%s: silhouette of %d pixels", photo_path, int(mask.sum()))
+    return to_upright(mask.view(np.uint8), photo.orientation).astype(bool)

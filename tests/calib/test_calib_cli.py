@@ -1,0 +1,221 @@
+"""The `calib` command: what it writes, what it prints, and one-line errors for bad input."""
+
+import json
+
+import cv2
+import numpy as np
+import pytest
+
+from bodyfit.calib.boards import BoardDetector, parse_board
+from bodyfit.calib.camera import load_camera
+from bodyfit.calib.undistort import undistort_image
+
+from calib_scenes import clutter, iou, studio_photo
+from calib_true_camera import IMAGE_SIZE, TRUE_DIST, TRUE_K
+
+CHESSBOARD = ("--board", "chessboard:9x6", "--square-mm", "25")
+
+
+@pytest.fixture(scope="module")
+def calibrated(tmp_path_factory, chessboard_shots):
+    """camera.json from `calib capture` on the first 9 views plus the blurred one."""
+    from bodyfit.calib.cli import main
+
+    folder = tmp_path_factory.mktemp("capture")
+    output = folder / "camera.json"
+    inputs = [str(p) for p in chessboard_shots.sharp[:9]] + [str(chessboard_shots.blurred)]
+    assert main(["capture", *inputs, *CHESSBOARD, "-o", str(output)]) == 0
+    return output, inputs
+
+
+def test_capture_writes_camera_json_with_its_provenance(calibrated):
+    output, inputs = calibrated
+    record = json.loads(output.read_text())
+    assert record["format"] == "bodyfit.camera/1"
+    assert record["image_size_px"] == list(IMAGE_SIZE)
+    np.testing.assert_allclose(record["K"], TRUE_K, rtol=0.005, atol=1.5)
+    assert len(record["dist"]) == 5 and record["dist"][2:] == [0.0, 0.0, 0.0]
+    assert set(record["std"]) == {"fx", "fy", "cx", "cy", "k1", "k2"}
+    for index, name in enumerate(("k1", "k2")):
+        assert abs(record["dist"][index] - TRUE_DIST[index]) <= 3 * record["std"][name]
+    assert record["model"] == "k1k2" and 0 < record["rms_px"] < 0.15
+    assert record["board"]["kind"] == "chessboard" and record["board"]["square_mm"] == 25.0
+    statuses = [view["status"] for view in record["views"]]
+    assert statuses == ["used"] * 9 + ["too blurry"]
+    assert all(view["error_px"] < 0.2 for view in record["views"][:9])
+    assert 0 < record["coverage_fraction"] <= 1
+    provenance = record["provenance"]
+    assert provenance["argv"][:2] == ["calib", "capture"] and provenance["inputs"] == inputs
+    assert provenance["bodyfit_version"] and provenance["time"].endswith("+00:00")
+    assert load_camera(output).board == parse_board("chessboard:9x6", 25)
+    coverage = cv2.imread(str(output.with_name("camera_coverage.png")))
+    assert coverage.shape[1] == 1200 and coverage.shape[0] == 675
+
+
+def test_capture_prints_the_summary(chessboard_shots, tmp_path, run_calib):
+    result = run_calib(
+        "capture",
+        *chessboard_shots.sharp[:5],
+        chessboard_shots.bent,
+        *CHESSBOARD,
+        "-o",
+        tmp_path / "cam.json",
+        "--coverage",
+        tmp_path / "cover.png",
+    )
+    assert result.code == 0, result.stderr
+    out = result.stdout
+    assert "views: 5 used, 1 rejected (1 outlier)" in out
+    assert "RMS reprojection error" in out and "worst view" in out
+    for name in ("fx", "fy", "cx", "cy", "k1", "k2"):
+        assert f"  {name} = " in out
+    assert "±" in out and f"wrote {tmp_path / 'cam.json'}" in out
+    assert (tmp_path / "cover.png").is_file()
+
+
+def test_check_reports_the_error_on_held_out_photos(calibrated, chessboard_shots, run_calib):
+    output, _ = calibrated
+    held_out = chessboard_shots.sharp[9:]
+    result = run_calib("check", output, *held_out)
+    assert result.code == 0, result.stderr
+    lines = result.stdout.splitlines()
+    held_out_line = next(line for line in lines if line.startswith("held-out RMS"))
+    rms = float(held_out_line.split()[4])
+    assert 0 < rms < 0.2
+    assert f"over {len(held_out)} of {len(held_out)} views" in held_out_line
+
+
+def test_undistort_writes_the_kornia_result(calibrated, chessboard_shots, tmp_path, run_calib):
+    output, _ = calibrated
+    photo = chessboard_shots.sharp[4]
+    result = run_calib("undistort", output, photo, "-o", tmp_path)
+    assert result.code == 0, result.stderr
+    written = cv2.imread(str(tmp_path / photo.name))
+    expected = undistort_image(cv2.imread(str(photo)), load_camera(output))
+    np.testing.assert_array_equal(written, expected)
+
+
+def test_silhouette_writes_the_mask(tmp_path, run_calib):
+    photo, truth = studio_photo((720, 960), [(360.0, 60.0, 820.0)], np.random.default_rng(4))
+    cv2.imwrite(str(tmp_path / "front.png"), photo)
+    result = run_calib("silhouette", tmp_path / "front.png", "-o", tmp_path / "mask.png")
+    assert result.code == 0, result.stderr
+    mask = cv2.imread(str(tmp_path / "mask.png"), cv2.IMREAD_GRAYSCALE)
+    assert set(np.unique(mask)) == {0, 255}
+    assert iou(mask > 0, truth) >= 0.99
+
+
+def test_board_draws_a_board_the_detector_finds(tmp_path, run_calib):
+    result = run_calib(
+        "board",
+        "--board",
+        "charuco:7x5",
+        "--square-mm",
+        "30",
+        "--marker-mm",
+        "22",
+        "--dict",
+        "DICT_4X4_50",
+        "--dpi",
+        "150",
+        "-o",
+        tmp_path / "board.png",
+    )
+    assert result.code == 0, result.stderr
+    assert "mm squares" in result.stdout
+    picture = cv2.imread(str(tmp_path / "board.png"), cv2.IMREAD_GRAYSCALE)
+    assert picture.shape == ((5 + 2) * 177, (7 + 2) * 177)  # 30 mm at 150 dpi: 177 px per square
+    detection = BoardDetector(parse_board("charuco:7x5", 30, 22, "DICT_4X4_50")).detect(picture)
+    assert detection is not None and len(detection.corner_ids) == 24
+
+
+# --- bad input: one line, exit code 2, nothing written ------------------------------------
+
+
+def _write(path, image):
+    cv2.imwrite(str(path), image)
+    return path
+
+
+@pytest.fixture
+def bad_inputs(tmp_path, chessboard_shots):
+    rng = np.random.default_rng(9)
+    blank = np.full((IMAGE_SIZE[1], IMAGE_SIZE[0]), 128, np.uint8)
+    inputs = {
+        "blank1": _write(tmp_path / "blank1.png", blank),
+        "blank2": _write(tmp_path / "blank2.png", blank),
+        "small": _write(tmp_path / "small.png", blank[:480, :640]),
+        "junk": tmp_path / "junk.jpg",
+        "corrupt_camera": tmp_path / "corrupt.json",
+        "incomplete_camera": tmp_path / "incomplete.json",
+        "clutter": _write(
+            tmp_path / "room.png",
+            studio_photo((720, 960), [(360.0, 60.0, 820.0)], rng, backdrop=clutter((720, 960), rng))[0],
+        ),
+        "nobody": _write(tmp_path / "nobody.png", studio_photo((720, 960), [], rng)[0]),
+        "cut": _write(tmp_path / "cut.png", studio_photo((720, 960), [(360.0, 200.0, 820.0)], rng)[0]),
+        "two": _write(
+            tmp_path / "two.png", studio_photo((720, 960), [(165.0, 100.0, 500.0), (555.0, 120.0, 500.0)], rng)[0]
+        ),
+        "view": chessboard_shots.sharp[0],
+        "view2": chessboard_shots.sharp[1],
+    }
+    inputs["junk"].write_bytes(b"\xff\xd8 this is not a JPEG")
+    inputs["corrupt_camera"].write_text('{"image_size_px": [1280, 720], "K": [[1050, 0, 648')
+    inputs["incomplete_camera"].write_text(json.dumps({"image_size_px": [1280, 720], "dist": [0, 0, 0, 0, 0]}))
+    return inputs
+
+
+OUT = "OUTPUT"  # replaced by the output path of each case
+
+BAD_INPUT_CASES = {
+    "no board in any view": (["capture", "blank1", "blank2", *CHESSBOARD, "-o", OUT], "no board found in any"),
+    "too few usable views": (["capture", "view", "view2", *CHESSBOARD, "-o", OUT], "only 2 usable views"),
+    "photos of different sizes": (["capture", "view", "small", *CHESSBOARD, "-o", OUT], "must all have one size"),
+    "unreadable file": (["capture", "view", "junk", *CHESSBOARD, "-o", OUT], "not a readable image"),
+    "missing file": (["capture", "view", "nowhere.png", *CHESSBOARD, "-o", OUT], "no such file"),
+    "missing square size": (["capture", "view", "--board", "chessboard:9x6", "-o", OUT], "--square-mm"),
+    "bad board": (["capture", "view", "--board", "chess:9", "--square-mm", "25", "-o", OUT], "KIND:COLSxROWS"),
+    "corrupt camera.json (undistort)": (["undistort", "corrupt_camera", "view", "-o", "DIR"], "not valid JSON"),
+    "incomplete camera.json (check)": (["check", "incomplete_camera", "view"], "missing K"),
+    "corrupt camera.json (silhouette)": (
+        ["silhouette", "nobody", "--camera", "corrupt_camera", "-o", OUT],
+        "not valid JSON",
+    ),
+    "backdrop not plain": (["silhouette", "clutter", "-o", OUT], "backdrop is not plain"),
+    "no person": (["silhouette", "nobody", "-o", OUT], "no person found"),
+    "person touching the frame edge": (["silhouette", "cut", "-o", OUT], "touches the bottom edge"),
+    "several people": (["silhouette", "two", "-o", OUT], "2 person-sized regions"),
+    "output folder missing": (["silhouette", "two", "-o", "missing/mask.png"], "does not exist"),
+    "usage error": (["capture", "--board", "chessboard:9x6"], "required"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_INPUT_CASES))
+def test_bad_input_is_one_line_exit_2_and_nothing_written(case, bad_inputs, tmp_path, run_calib):
+    arguments, complaint = BAD_INPUT_CASES[case]
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    output = out_dir / "result.json"
+    argv = []
+    for argument in arguments:
+        if argument == OUT:
+            argv.append(output)
+        elif argument == "DIR":
+            argv.append(out_dir)
+        elif argument == "missing/mask.png":
+            argv.append(tmp_path / "missing" / "mask.png")
+        else:
+            argv.append(bad_inputs.get(argument, argument))
+    result = run_calib(*argv)
+    assert result.code == 2
+    assert result.stderr.startswith("calib: error: ") and result.stderr.count("\n") == 1, result.stderr
+    assert complaint in result.stderr
+    assert "Traceback" not in result.stderr
+    assert list(out_dir.iterdir()) == []
+
+
+def test_help_states_the_units(run_calib):
+    result = run_calib("capture", "--help")
+    assert result.code == 0
+    assert "millimetres" in result.stdout and "pixels" in result.stdout

@@ -1,0 +1,150 @@
+"""Silhouettes of a synthetic person: accuracy, shadows, plates, holes and refusals."""
+
+import cv2
+import numpy as np
+import pytest
+
+from bodyfit.calib.camera import Camera
+from bodyfit.calib.errors import UserError
+from bodyfit.calib.silhouette import (
+    SilhouetteSettings,
+    extract_silhouette,
+    load_mask,
+    photo_silhouette,
+)
+from bodyfit.calib.synthetic import distort_image
+from bodyfit.calib.undistort import undistort_image
+
+from calib_scenes import BACKDROP, clutter, exif_with_orientation, iou, studio_photo
+
+SIZE = (720, 960)  # portrait, width x height
+PERSON = (360.0, 60.0, 820.0)  # centre x, top y, height, pixels
+
+
+@pytest.fixture(scope="module")
+def studio():
+    return studio_photo(SIZE, [PERSON], np.random.default_rng(0))
+
+
+def test_person_on_a_plain_backdrop_with_shadow_and_noise(studio):
+    photo, truth = studio
+    mask = extract_silhouette(photo)
+    assert mask.shape == truth.shape and mask.dtype == bool
+    assert iou(mask, truth) >= 0.99
+
+
+def test_a_soft_photo_keeps_its_outline_where_edges_are_half_way(studio):
+    # Lens blur mixes person and backdrop over a few pixels; the truth outline is the
+    # 50 % line, which the outline refinement finds (a plain threshold lands outside it).
+    photo, truth = studio
+    soft = cv2.GaussianBlur(photo, (0, 0), 1.2)
+    assert iou(extract_silhouette(soft), truth) >= 0.99
+    unrefined = extract_silhouette(soft, settings=SilhouetteSettings(outline_band_px=0))
+    assert iou(unrefined, truth) < 0.98
+
+
+def test_the_shadow_is_really_there(studio):
+    photo, truth = studio
+    # Right of the legs the shadow darkens the backdrop by up to 40 %.
+    shaded = photo[700:800, 470:520].reshape(-1, 3).mean(axis=0)
+    assert shaded.sum() < 0.75 * np.sum(BACKDROP)
+    assert not truth[700:800, 470:520].any()
+
+
+def test_background_plate_handles_a_busy_room():
+    rng = np.random.default_rng(1)
+    room = clutter(SIZE, rng)
+    photo, truth = studio_photo(SIZE, [PERSON], rng, backdrop=room, shadow=False)
+    plate = np.clip(room + rng.normal(0.0, 4.0, room.shape), 0, 255).astype(np.uint8)
+    assert iou(extract_silhouette(photo, plate), truth) >= 0.99
+    with pytest.raises(UserError, match="backdrop is not plain"):
+        extract_silhouette(photo)
+
+
+def test_small_holes_are_filled_and_large_gaps_kept():
+    rng = np.random.default_rng(2)
+    photo, truth = studio_photo(SIZE, [PERSON], rng, shadow=False)
+    # A backdrop-coloured logo on the shirt (a small hole) ...
+    photo[300:318, 350:368] = BACKDROP
+    # ... and a hand on the hip closing a large gap between arm and body.
+    gap = np.zeros(truth.shape, np.uint8)
+    cv2.fillConvexPoly(gap, np.array([[150, 470], [250, 280], [260, 470]], np.int32), 1)
+    gap = gap.astype(bool) & ~truth
+    bridge = np.zeros(truth.shape, np.uint8)
+    cv2.line(bridge, (150, 470), (300, 470), 1, 14)
+    photo[bridge.astype(bool)] = (120, 150, 205)
+    truth = truth | bridge.astype(bool)
+    gap &= ~truth
+    _, background_labels = cv2.connectedComponents((~truth).astype(np.uint8), connectivity=4)
+    assert background_labels[0, 0] not in background_labels[gap]  # the gap is enclosed
+    mask = extract_silhouette(photo)
+    assert mask[300:318, 350:368].all()
+    # The gap is enclosed (a hole of the person) and stays open, up to its rim.
+    inner_gap = cv2.erode(gap.astype(np.uint8), np.ones((5, 5), np.uint8)).astype(bool)
+    assert inner_gap.sum() > 0.01 * truth.sum()
+    assert not mask[inner_gap].any()
+    assert iou(mask, truth) >= 0.99
+
+
+@pytest.mark.parametrize(
+    "people, complaint",
+    [
+        ([], "no person found"),
+        ([(360.0, 200.0, 820.0)], "touches the bottom edge"),
+        ([(165.0, 100.0, 500.0), (555.0, 120.0, 500.0)], "2 person-sized regions"),
+    ],
+)
+def test_bad_scenes_are_user_errors(people, complaint):
+    photo, _ = studio_photo(SIZE, people, np.random.default_rng(3))
+    with pytest.raises(UserError, match=complaint):
+        extract_silhouette(photo)
+
+
+def test_plate_of_another_size_is_a_user_error(studio):
+    photo, _ = studio
+    with pytest.raises(UserError, match="background plate is"):
+        extract_silhouette(photo, photo[:-10])
+
+
+def test_photo_silhouette_undistorts_and_turns_upright(tmp_path, studio):
+    # The studio scene as a distorting lens would record it, stored sideways in the
+    # sensor frame with EXIF orientation 6 (turn 90 degrees clockwise to view).
+    ideal_photo, truth = studio
+    K = np.array([[800.0, 0.0, 480.0], [0.0, 800.0, 360.0], [0.0, 0.0, 1.0]])
+    # Pincushion, so that the recorded frame sees only the rendered scene.
+    dist = np.array([0.08, 0.02, 0.0, 0.0, 0.0])
+    sensor_ideal = cv2.rotate(ideal_photo, cv2.ROTATE_90_COUNTERCLOCKWISE)
+    sensor_photo = distort_image(sensor_ideal, K, dist)
+    camera = Camera((sensor_photo.shape[1], sensor_photo.shape[0]), K, dist)
+    path = tmp_path / "front.jpg"
+    cv2.imwriteWithMetadata(
+        str(path),
+        sensor_photo,
+        [cv2.IMAGE_METADATA_EXIF],
+        [exif_with_orientation(6, "<")],
+        [cv2.IMWRITE_JPEG_QUALITY, 98],
+    )
+    mask = photo_silhouette(path, camera)
+    assert mask.shape == truth.shape
+    # Undistortion loses the corners the lens never saw; compare where the ideal image is seen.
+    seen = cv2.rotate(
+        undistort_image(np.full(sensor_photo.shape[:2], 255, np.uint8), camera) > 250, cv2.ROTATE_90_CLOCKWISE
+    )
+    assert iou(mask & seen, truth & seen) >= 0.99
+
+
+def test_load_mask_reads_user_masks(tmp_path, studio):
+    _, truth = studio
+    path = tmp_path / "mask.png"
+    cv2.imwrite(str(path), truth.astype(np.uint8) * 255)
+    np.testing.assert_array_equal(load_mask(path), truth)
+    cv2.imwrite(str(path), np.zeros(truth.shape, np.uint8))
+    with pytest.raises(UserError, match="all black"):
+        load_mask(path)
+    with pytest.raises(UserError, match="no such file"):
+        load_mask(tmp_path / "none.png")
+
+
+def test_settings_are_checked():
+    with pytest.raises(ValueError, match="odd"):
+        SilhouetteSettings(median_px=4)
