@@ -19,12 +19,14 @@ Frame and units everywhere: metres, model frame, z up, -y forward (the body face
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 from pathlib import Path
 
 import numpy as np
 
 from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import write_atomic
 
 __all__ = [
     "PART_NAMES",
@@ -136,10 +138,9 @@ class BodyModel:
         arrays.update({f"landmark:{k}": v for k, v in self.landmarks.items()})
         meta = dict(self.metadata, format_version=FORMAT_VERSION)
         arrays["metadata_json"] = np.array(json.dumps(meta))
-        tmp = path.with_name(path.name + ".partial")
-        with open(tmp, "wb") as fh:
-            np.savez(fh, **arrays)
-        tmp.replace(path)
+        buffer = io.BytesIO()
+        np.savez(buffer, **arrays)
+        write_atomic(path, buffer.getvalue())
 
     @classmethod
     def load(cls, path: Path) -> "BodyModel":

@@ -15,7 +15,8 @@ import numpy as np
 from bodyfit.fitter.body_model import BodyModel, rest_shape
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.mesh_io import write_mesh
-from bodyfit.fitter.outputs import staged_directory, write_measurements, write_png
+from bodyfit.calib.images import write_image
+from bodyfit.fitter.outputs import staged_directory, write_measurements
 from bodyfit.fitter.render import parts_legend, render_parts
 
 __all__ = ["DemoSettings", "run_demo"]
@@ -56,7 +57,7 @@ def run_demo(model: BodyModel, out_dir: Path, settings: DemoSettings = DemoSetti
         csv_path = write_measurements(stage / "measurements.json",
                                       {name: measurer.measure(v) for name, v in zip(names, rest)},
                                       provenance)
-        write_png(stage / "bodies.png", picture)
+        write_image(stage / "bodies.png", picture)
         written += [out_dir / "measurements.json", out_dir / csv_path.name,
                     out_dir / "bodies.png"]
     return written

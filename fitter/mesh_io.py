@@ -13,6 +13,7 @@ import numpy as np
 import trimesh
 
 from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import write_atomic
 
 __all__ = ["MESH_SUFFIXES", "UNITS_TO_METRES", "write_mesh", "read_mesh"]
 
@@ -33,9 +34,7 @@ def write_mesh(path: Path, vertices: np.ndarray, faces: np.ndarray) -> None:
         raise UserError(f"cannot write {path}: mesh files end in .obj or .ply")
     mesh = trimesh.Trimesh(np.asarray(vertices, np.float64), np.asarray(faces), process=False)
     data = mesh.export(file_type=path.suffix.lower()[1:])
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_bytes(data if isinstance(data, bytes) else data.encode())
-    tmp.replace(path)
+    write_atomic(path, data if isinstance(data, bytes) else data.encode())
 
 
 def read_mesh(path: Path, faces: np.ndarray, units: str = "m") -> np.ndarray:

@@ -1,6 +1,7 @@
 """Writing result files atomically: a failed run leaves no half-written output.
 
-Every writer writes a temporary file beside the target and renames it into place.
+Single files go through :func:`bodyfit.calib.files.write_atomic` (a temporary file and
+a rename); a run's set of files is staged in a directory and moved in at the end.
 """
 
 from __future__ import annotations
@@ -13,13 +14,10 @@ import shutil
 import tempfile
 from pathlib import Path
 
-import cv2
-import numpy as np
-
-from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import write_atomic
 from bodyfit.fitter.measurements import MEASUREMENTS
 
-__all__ = ["staged_directory", "write_text", "write_png", "write_json", "write_measurements"]
+__all__ = ["staged_directory", "write_text", "write_json", "write_measurements"]
 
 
 @contextlib.contextmanager
@@ -41,21 +39,7 @@ def staged_directory(out_dir: Path):
 
 
 def write_text(path: Path, text: str) -> None:
-    path = Path(path)
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_text(text)
-    tmp.replace(path)
-
-
-def write_png(path: Path, image: np.ndarray) -> None:
-    """Write a (H, W, 3) uint8 BGR (or (H, W) grey) image as PNG, atomically."""
-    ok, data = cv2.imencode(".png", image)
-    if not ok:
-        raise UserError(f"could not encode {path} as PNG")
-    path = Path(path)
-    tmp = path.with_name(path.name + ".partial")
-    tmp.write_bytes(data.tobytes())
-    tmp.replace(path)
+    write_atomic(path, text.encode())
 
 
 def write_json(path: Path, payload: dict) -> None:

@@ -27,7 +27,8 @@ from bodyfit.fitter.anny_source import AnnySource
 from bodyfit.fitter.body_model import BodyModel, project_shape, rest_shape
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model, model_path
-from bodyfit.fitter.outputs import write_png, write_text
+from bodyfit.calib.images import write_image
+from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.model_build import ModelBuildSettings
 from bodyfit.fitter.population import SEXES, PopulationSampler, ReferenceStats
 from bodyfit.fitter.render import parts_legend, render_parts
@@ -158,7 +159,7 @@ def main() -> None:
 
     views = [render_parts(model.mean_vertices, model.faces, model.face_parts, view, 700)
              for view in ("front", "side")]
-    write_png(args.docs / "model_parts.png", np.concatenate(views + [parts_legend(700)], axis=1))
+    write_image(args.docs / "model_parts.png", np.concatenate(views + [parts_legend(700)], axis=1))
     lines += ["## Part labels", "",
               "The mean body, front and side, coloured by the paper's nine parts (Table 2); "
               "see `fitter/parts.py` for how they are derived.", "",
