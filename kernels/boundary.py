@@ -5,9 +5,10 @@ silhouette or outside the image (the inner boundary, an 8-connected contour like
 the paper's Moore-neighbour tracing follows); :func:`bodyfit.kernels.target.boundary_mask`
 is the same definition for the person's mask.
 
-Row scan: one thread per (candidate, row) reads the row and its two neighbours once and
-writes the row's boundary *runs*, maximal sequences of consecutive boundary pixels of one
-part (at most W per row), and the row's silhouette moments for the alignment.
+Row scan: one thread per (candidate, row) skips the background, and for each span of
+silhouette pixels adds its moments in closed form (for the alignment) and writes the
+row's boundary *runs*, maximal sequences of consecutive boundary pixels of one part (at
+most W per row): span ends, and span pixels with the background above or below.
 
 Nearest boundary pixel of a query point (x, y): visit rows in order of increasing
 |row - y| and stop once (row - y)^2 is no smaller than the best squared distance found;
@@ -80,6 +81,22 @@ def _is_inside(keys: wp.array3d(dtype=wp.int32), p: int, y: int, x: int):
     return keys[p, y, x] != BACKGROUND
 
 
+@wp.func
+def _sum_of_integers(first: wp.int64, last: wp.int64):
+    """first + (first + 1) + ... + last, exactly."""
+    return (first + last) * (last - first + wp.int64(1)) / wp.int64(2)
+
+
+@wp.func
+def _sum_of_squares(first: wp.int64, last: wp.int64):
+    """first^2 + ... + last^2 for 0 <= first <= last, exactly."""
+    one = wp.int64(1)
+    two = wp.int64(2)
+    upper = last * (last + one) * (two * last + one)
+    lower = (first - one) * first * (two * first - one)
+    return (upper - lower) / wp.int64(6)
+
+
 @wp.kernel(enable_backward=False)
 def _row_scan_kernel(keys: wp.array3d(dtype=wp.int32), runs: wp.array3d(dtype=wp.int32),
                      run_counts: wp.array2d(dtype=wp.int32),
@@ -95,35 +112,37 @@ def _row_scan_kernel(keys: wp.array3d(dtype=wp.int32), runs: wp.array3d(dtype=wp
     first = int(-1)
     last = int(-2)
     part_open = int(-1)
-    left_inside = bool(False)
-    key = keys[p, y, 0]
-    for x in range(width):
-        right_key = wp.int32(BACKGROUND)
-        if x + 1 < width:
-            right_key = keys[p, y, x + 1]
-        if key != BACKGROUND:
-            xi = wp.int64(x)
-            pixels = pixels + wp.int64(1)
-            sum_x = sum_x + xi
-            sum_xx = sum_xx + xi * xi
-            on_boundary = edge_row or not left_inside or right_key == BACKGROUND
+    x = int(0)
+    while x < width:
+        while x < width and keys[p, y, x] == BACKGROUND:  # skip the background
+            x = x + 1
+        span_start = x
+        while x < width and keys[p, y, x] != BACKGROUND:  # a span of silhouette pixels
+            x = x + 1
+        span_end = x - 1
+        if span_end < span_start:
+            break
+        lo = wp.int64(span_start)
+        hi = wp.int64(span_end)
+        pixels = pixels + hi - lo + wp.int64(1)
+        sum_x = sum_x + _sum_of_integers(lo, hi)
+        sum_xx = sum_xx + _sum_of_squares(lo, hi)
+        for c in range(span_start, span_end + 1):
+            # span ends, and pixels next to the background above or below, are boundary
+            on_boundary = edge_row or c == span_start or c == span_end
             if not on_boundary:
-                on_boundary = not _is_inside(keys, p, y - 1, x) or not _is_inside(keys, p, y + 1, x)
+                on_boundary = not _is_inside(keys, p, y - 1, c) or not _is_inside(keys, p, y + 1, c)
             if on_boundary:
-                part = int(key & _PART_MASK)
-                if x == last + 1 and part == part_open:
-                    last = x
+                part = int(keys[p, y, c] & _PART_MASK)
+                if c == last + 1 and part == part_open:
+                    last = c
                 else:
                     if part_open >= 0:
                         runs[p, y, count] = _pack_run(first, last, part_open)
                         count = count + 1
-                    first = x
-                    last = x
+                    first = c
+                    last = c
                     part_open = part
-            left_inside = True
-        else:
-            left_inside = False
-        key = right_key
     if part_open >= 0:
         runs[p, y, count] = _pack_run(first, last, part_open)
         count = count + 1

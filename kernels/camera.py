@@ -31,7 +31,6 @@ __all__ = [
     "pinhole_camera",
     "camera_matrices",
     "project_point",
-    "depth_from_screen",
 ]
 
 #: (D_x, D_y, D_z) in degrees of the paper's front and side projections (Eq. 10-12).
@@ -67,7 +66,8 @@ def project_point(cam: Camera, x: wp.vec3):
     """Pixel coordinates (u, v) and the screen-linear depth value q of a model-frame point.
 
     q is z_cam for an orthographic camera and 1/z_cam for a pinhole one: in both cases q
-    varies linearly across a projected triangle, so it can be interpolated per pixel.
+    varies linearly across a projected triangle, so it can be interpolated per pixel (and
+    the depth is q, or 1/q).
     """
     c = cam.rotation * x + cam.translation
     s = float(1.0)
@@ -76,14 +76,6 @@ def project_point(cam: Camera, x: wp.vec3):
         s = 1.0 / c[2]
         q = s
     return wp.vec3(cam.fx * c[0] * s + cam.skew * c[1] * s + cam.cx, cam.fy * c[1] * s + cam.cy, q)
-
-
-@wp.func
-def depth_from_screen(cam: Camera, q: float):
-    """Depth z_cam (metres) from an interpolated screen-linear depth value q."""
-    if cam.pinhole != 0:
-        return 1.0 / q
-    return q
 
 
 def paper_rotation(view_deg) -> np.ndarray:

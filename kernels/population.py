@@ -78,6 +78,10 @@ class _ViewState:
         self.row_sums = wp.empty((chunk, view.height), dtype=PartVector, device=dev)
         self.row_pixels = wp.empty((chunk, view.height), dtype=wp.int32, device=dev)
 
+    def arrays(self) -> list[wp.array]:
+        return [v for v in (*vars(self).values(), *vars(self.scan).values())
+                if isinstance(v, wp.array)]
+
     def scan_rows(self, num: int) -> BoundaryRuns:
         return BoundaryRuns(self.scan.runs[:num], self.scan.run_counts[:num],
                             self.scan.row_moments[:num])
@@ -127,6 +131,12 @@ class PopulationEvaluator:
         self._term_costs = wp.empty((chunk, len(TERM_NAMES)), dtype=wp.float32, device=dev)
         self._costs = wp.empty(chunk, dtype=wp.float32, device=dev)
         self._clock = 0.0
+
+    def buffer_bytes(self) -> int:
+        """Bytes of device memory held by this evaluator (model data excluded)."""
+        arrays = [v for v in vars(self).values() if isinstance(v, wp.array)]
+        arrays += [a for state in self._views for a in state.arrays()]
+        return sum(a.capacity for a in arrays)
 
     def _stage_done(self, stage: str) -> None:
         if self.profile:

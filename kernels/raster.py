@@ -11,8 +11,9 @@ edge (centre sampling, the rule of GPU rasterisers); that keeps silhouettes unbi
 with no half-pixel dilation. Triangles facing away from the camera are skipped (the body
 mesh is closed, so front faces alone make the silhouette and the visible labels).
 
-One thread per (candidate, triangle). On one CPU core the cost is dominated by the
-per-triangle setup of the many sub-pixel triangles of hands, face and feet.
+One thread per (candidate, triangle) on CUDA, per (candidate, block of 64 triangles) on
+a CPU. On one CPU core the cost is dominated by the per-triangle setup of the many
+sub-pixel triangles of hands, face and feet.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from bodyfit.kernels.camera import Camera, depth_from_screen, project_point
+from bodyfit.kernels.camera import Camera, project_point
 from bodyfit.kernels.device import device_array, resolve_device
 
 __all__ = [
@@ -49,6 +50,9 @@ _INSIDE_TOLERANCE = 1.0e-5
 #: Triangles whose bounding box is at least this many pixels wide scan only the part of
 #: each row between their edges; narrower ones test every pixel centre of the box.
 _SPAN_MIN_WIDTH = 4
+#: Triangles per CPU thread (Warp runs CPU threads one after the other: fewer, longer
+#: threads save the per-thread overhead); one per thread on CUDA.
+_CPU_FACES_PER_THREAD = 64
 
 
 @wp.kernel(enable_backward=False)
@@ -80,71 +84,79 @@ def _span_bound(slope: float, offset: float, lo: float, hi: float):
 @wp.kernel(enable_backward=False)
 def _raster_kernel(cam: Camera, screen: wp.array2d(dtype=wp.vec3),
                    faces: wp.array(dtype=wp.vec3i), face_parts: wp.array(dtype=wp.int32),
-                   keys: wp.array3d(dtype=wp.int32)):
-    p, f = wp.tid()
-    tri = faces[f]
-    a = screen[p, tri[0]]
-    b = screen[p, tri[1]]
-    c = screen[p, tri[2]]
-    e1x = b[0] - a[0]
-    e1y = b[1] - a[1]
-    e2x = c[0] - a[0]
-    e2y = c[1] - a[1]
-    # Twice the signed area in (column, row) coordinates: negative when the triangle,
-    # counter-clockwise seen from outside, faces the camera (see camera.py for the frame).
-    area = e1x * e2y - e1y * e2x
-    if area >= 0.0:
-        return
-    if cam.pinhole != 0 and (a[2] <= 0.0 or b[2] <= 0.0 or c[2] <= 0.0):
-        return  # a vertex behind the camera
-    height = keys.shape[1]
-    width = keys.shape[2]
-    min_x = wp.max(wp.min(wp.min(a[0], b[0]), c[0]), 0.0)
-    max_x = wp.min(wp.max(wp.max(a[0], b[0]), c[0]), float(width - 1))
-    min_y = wp.max(wp.min(wp.min(a[1], b[1]), c[1]), 0.0)
-    max_y = wp.min(wp.max(wp.max(a[1], b[1]), c[1]), float(height - 1))
-    if max_x < min_x or max_y < min_y:
-        return  # off the image
-    x0 = _ceil_nonnegative(min_x)
-    x1 = int(max_x)
-    y0 = _ceil_nonnegative(min_y)
-    y1 = int(max_y)
-    if x0 > x1 or y0 > y1:
-        return  # no pixel centre inside the bounding box (most sub-pixel triangles)
-    # Barycentric coordinates of the point a + (dx, dy) are affine:
-    # l_b = bx * dx + by * dy, l_c = cx * dx + cy * dy, l_a = 1 - l_b - l_c.
-    inv_area = 1.0 / area
-    bx = e2y * inv_area
-    by = -e2x * inv_area
-    cx = -e1y * inv_area
-    cy = e1x * inv_area
-    qa = a[2]
-    qb = b[2] - qa
-    qc = c[2] - qa
-    key_part = face_parts[f]
-    narrow = x1 - x0 < _SPAN_MIN_WIDTH
-    for y in range(y0, y1 + 1):
-        dy = float(y) - a[1]
-        b0 = by * dy
-        c0 = cy * dy
-        xs = x0
-        xe = x1
-        if not narrow:  # skip the pixels of the row that are clearly outside
-            span = _span_bound(bx, b0, float(x0) - a[0], float(x1) - a[0])
-            span = _span_bound(cx, c0, span[0], span[1])
-            span = _span_bound(-bx - cx, 1.0 - b0 - c0, span[0], span[1])
-            if span[1] < span[0]:
-                continue
-            xs = _ceil_nonnegative(span[0] + a[0])
-            xe = int(span[1] + a[0])
-        for x in range(xs, xe + 1):
-            dx = float(x) - a[0]
-            lb = b0 + bx * dx
-            lc = c0 + cx * dx
-            if lb >= -_INSIDE_TOLERANCE and lc >= -_INSIDE_TOLERANCE and lb + lc <= 1.0 + _INSIDE_TOLERANCE:
-                z = depth_from_screen(cam, qa + qb * lb + qc * lc)
-                step = int(wp.clamp(z * _DEPTH_STEPS_PER_METRE, 0.0, float(_MAX_DEPTH_STEP)))
-                wp.atomic_min(keys, p, y, x, (step << PART_BITS) | key_part)
+                   faces_per_thread: int, keys: wp.array3d(dtype=wp.int32)):
+    p, block = wp.tid()
+    first_face = block * faces_per_thread
+    for f in range(first_face, wp.min(first_face + faces_per_thread, faces.shape[0])):
+        tri = faces[f]
+        a = screen[p, tri[0]]
+        b = screen[p, tri[1]]
+        c = screen[p, tri[2]]
+        e1x = b[0] - a[0]
+        e1y = b[1] - a[1]
+        e2x = c[0] - a[0]
+        e2y = c[1] - a[1]
+        # Twice the signed area in (column, row) coordinates: negative when the triangle,
+        # counter-clockwise seen from outside, faces the camera (see camera.py for the frame).
+        area = e1x * e2y - e1y * e2x
+        if area >= 0.0:
+            continue
+        if cam.pinhole != 0 and (a[2] <= 0.0 or b[2] <= 0.0 or c[2] <= 0.0):
+            continue  # a vertex behind the camera
+        height = keys.shape[1]
+        width = keys.shape[2]
+        min_x = wp.max(wp.min(wp.min(a[0], b[0]), c[0]), 0.0)
+        max_x = wp.min(wp.max(wp.max(a[0], b[0]), c[0]), float(width - 1))
+        min_y = wp.max(wp.min(wp.min(a[1], b[1]), c[1]), 0.0)
+        max_y = wp.min(wp.max(wp.max(a[1], b[1]), c[1]), float(height - 1))
+        if max_x < min_x or max_y < min_y:
+            continue  # off the image
+        x0 = _ceil_nonnegative(min_x)
+        x1 = int(max_x)
+        y0 = _ceil_nonnegative(min_y)
+        y1 = int(max_y)
+        if x0 > x1 or y0 > y1:
+            continue  # no pixel centre inside the bounding box (most sub-pixel triangles)
+        # Barycentric coordinates of the point a + (dx, dy) are affine:
+        # l_b = bx * dx + by * dy, l_c = cx * dx + cy * dy, l_a = 1 - l_b - l_c.
+        inv_area = 1.0 / area
+        bx = e2y * inv_area
+        by = -e2x * inv_area
+        cx = -e1y * inv_area
+        cy = e1x * inv_area
+        qa = a[2]
+        qb = b[2] - qa
+        qc = c[2] - qa
+        key_part = face_parts[f]
+        pinhole = cam.pinhole != 0
+        narrow = x1 - x0 < _SPAN_MIN_WIDTH
+        for y in range(y0, y1 + 1):
+            dy = float(y) - a[1]
+            b0 = by * dy
+            c0 = cy * dy
+            xs = x0
+            xe = x1
+            if not narrow:  # skip the pixels of the row that are clearly outside
+                span = _span_bound(bx, b0, float(x0) - a[0], float(x1) - a[0])
+                span = _span_bound(cx, c0, span[0], span[1])
+                span = _span_bound(-bx - cx, 1.0 - b0 - c0, span[0], span[1])
+                if span[1] < span[0]:
+                    continue
+                # another half pixel of slack absorbs rounding; each pixel is tested anyway
+                xs = wp.max(x0, _ceil_nonnegative(wp.max(span[0] + a[0] - 0.5, 0.0)))
+                xe = wp.min(x1, int(wp.max(span[1] + a[0] + 0.5, 0.0)))
+            for x in range(xs, xe + 1):
+                # branch-free: a pixel outside the triangle writes BACKGROUND, a no-op for min
+                dx = float(x) - a[0]
+                lb = b0 + bx * dx
+                lc = c0 + cx * dx
+                q = qa + qb * lb + qc * lc
+                if pinhole:
+                    q = 1.0 / q
+                step = int(wp.clamp(q * _DEPTH_STEPS_PER_METRE, 0.0, float(_MAX_DEPTH_STEP)))
+                inside = wp.min(wp.min(lb, lc), 1.0 - lb - lc) >= -_INSIDE_TOLERANCE
+                wp.atomic_min(keys, p, y, x, wp.where(inside, (step << PART_BITS) | key_part,
+                                                      BACKGROUND))
 
 
 @wp.kernel(enable_backward=False)
@@ -167,8 +179,10 @@ def launch_raster(cam: Camera, screen: wp.array, faces: wp.array, face_parts: wp
                   keys: wp.array) -> None:
     """Clear (P, H, W) int32 ``keys`` to ``BACKGROUND`` and rasterise into them (no checks)."""
     keys.fill_(BACKGROUND)
-    wp.launch(_raster_kernel, dim=(screen.shape[0], faces.shape[0]), device=screen.device,
-              inputs=[cam, screen, faces, face_parts], outputs=[keys])
+    per_thread = 1 if screen.device.is_cuda else _CPU_FACES_PER_THREAD
+    blocks = (faces.shape[0] + per_thread - 1) // per_thread
+    wp.launch(_raster_kernel, dim=(screen.shape[0], blocks), device=screen.device,
+              inputs=[cam, screen, faces, face_parts, per_thread], outputs=[keys])
 
 
 def decode_labels(keys: wp.array) -> wp.array:
