@@ -20,11 +20,15 @@ from bodyfit.kernels.alignment import SilhouetteFrame, TargetFrame, silhouette_f
 from bodyfit.kernels.camera import Camera
 from bodyfit.kernels.device import resolve_device
 
-__all__ = ["VIEW_NAMES", "ViewTarget", "prepare_view_target", "boundary_mask",
-           "boundary_distance"]
+__all__ = ["VIEW_NAMES", "SIDE_VIEW_PARTS", "ViewTarget", "prepare_view_target",
+           "boundary_mask", "boundary_distance"]
 
 #: The two views of the paper, in the order their weights appear in Table 2.
 VIEW_NAMES = ("front", "side")
+#: Parts rendered in the side view: the paper's side photo is taken with the hands against
+#: the body, so no arm silhouette appears there, while the model's A-pose arms hang forward
+#: (and its four pose angles cannot swing them back): arm, elbow and hand are left out.
+SIDE_VIEW_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
 
 _CROSS = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
 

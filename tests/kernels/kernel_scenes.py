@@ -15,8 +15,6 @@ HEIGHT = 512
 FRONT_WIDTH = 352
 SIDE_WIDTH = 192
 PIXELS_PER_METRE = 270.0
-#: Parts rendered in the side view when the hands are held against the body.
-SIDE_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
 
 DEVICES = [
     "cpu",

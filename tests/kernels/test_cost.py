@@ -11,10 +11,10 @@ from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
 from bodyfit.kernels.population import PopulationEvaluator, evaluate_population
 from bodyfit.kernels.reference import population_cost, view_terms
 from bodyfit.kernels.skinning import ModelArrays
-from bodyfit.kernels.target import prepare_view_target
+from bodyfit.kernels.target import SIDE_VIEW_PARTS, prepare_view_target
 
-from kernel_scenes import (DEVICES, FRONT_WIDTH, PIXELS_PER_METRE, SIDE_PARTS, SIDE_WIDTH,
-                           front_camera, random_bodies, render_masks, side_camera)
+from kernel_scenes import (DEVICES, FRONT_WIDTH, PIXELS_PER_METRE, SIDE_WIDTH, front_camera,
+                           random_bodies, render_masks, side_camera)
 
 MM_PER_PX = 1000.0 / PIXELS_PER_METRE
 
@@ -24,7 +24,7 @@ def truth():
     return random_bodies(1, seed=11, spread=1.5)
 
 
-def _views(body_model, betas, pose, device="cpu", side_parts=SIDE_PARTS):
+def _views(body_model, betas, pose, device="cpu", side_parts=SIDE_VIEW_PARTS):
     """Front and side views of a person who is the body (betas, pose)."""
     front = render_masks(body_model, betas, pose, front_camera(), FRONT_WIDTH)[0] >= 0
     side = render_masks(body_model, betas, pose, side_camera(), SIDE_WIDTH, side_parts)[0] >= 0
