@@ -34,8 +34,9 @@ __all__ = ["STAGES", "PopulationCost", "PopulationEvaluator", "evaluate_populati
 #: Stages timed by ``PopulationEvaluator(profile=True)``.
 STAGES = ("skin", "raster", "distance", "cost")
 
-#: Candidates per kernel launch: a few on a CPU (the maps stay in cache), thousands on a GPU.
-DEFAULT_CHUNK = {"cpu": 8, "cuda": 4096}
+#: Candidates per kernel launch: tens on a CPU (bounded memory, maps near the cache),
+#: thousands on a GPU (enough threads to fill it).
+DEFAULT_CHUNK = {"cpu": 32, "cuda": 4096}
 
 
 class PopulationCost(NamedTuple):
@@ -55,19 +56,24 @@ class PopulationCost(NamedTuple):
 class _ViewState:
     """A view's constant device data and its per-chunk buffers."""
 
-    def __init__(self, view: ViewTarget, model: ModelArrays, settings: CostSettings, chunk: int):
+    def __init__(self, view: ViewTarget, model: ModelArrays, settings: CostSettings):
         dev = model.device
         ids = [PART_NAMES.index(name) for name in view.visible_parts]
         keep = np.isin(model.face_parts, ids)
         self.view = view
+        self.num_vertices = model.num_vertices
         self.faces = wp.array(model.faces[keep], dtype=wp.vec3i, device=dev)
         self.face_parts = wp.array(model.face_parts[keep].astype(np.int32), dtype=wp.int32,
                                    device=dev)
         self.params = cost_params(settings, view.name, view.millimetres_per_pixel)
         self.frame = view.target_frame
+
+    def allocate(self, chunk: int) -> None:
+        """(Re)allocate the buffers for chunks of up to ``chunk`` candidates."""
+        view, dev = self.view, self.faces.device
         num_points = view.boundary_points.shape[0]
         size = (chunk, view.height, view.width)
-        self.screen = wp.empty((chunk, model.num_vertices), dtype=wp.vec3, device=dev)
+        self.screen = wp.empty((chunk, self.num_vertices), dtype=wp.vec3, device=dev)
         self.keys = wp.empty(size, dtype=wp.int32, device=dev)
         self.scan = allocate_runs(*size, dev)
         self.transforms = wp.empty(chunk, dtype=wp.mat33, device=dev)
@@ -90,7 +96,8 @@ class _ViewState:
 class PopulationEvaluator:
     """Evaluates populations of (betas, pose) against one person's views.
 
-    Device buffers are allocated once, here, and reused by every :meth:`evaluate`.
+    Device buffers are allocated by the first :meth:`evaluate` (for min(P, chunk size)
+    candidates), grown if a later population needs more, and otherwise reused.
 
     Args:
         model: the body model on the device the views were prepared for.
@@ -123,14 +130,21 @@ class PopulationEvaluator:
         self.chunk_size = chunk
         self.profile = profile
         self.stage_seconds = dict.fromkeys(STAGES, 0.0)
-        dev = model.device
-        self._views = [_ViewState(v, model, settings, chunk) for v in views]
-        self._joints = wp.empty((chunk, len(POSE_NAMES)), dtype=wp.vec3, device=dev)
-        self._rotations = wp.empty((chunk, len(POSE_NAMES)), dtype=wp.mat33, device=dev)
-        self._vertices = wp.empty((chunk, model.num_vertices), dtype=wp.vec3, device=dev)
-        self._term_costs = wp.empty((chunk, len(TERM_NAMES)), dtype=wp.float32, device=dev)
-        self._costs = wp.empty(chunk, dtype=wp.float32, device=dev)
+        self._views = [_ViewState(v, model, settings) for v in views]
+        self._capacity = 0
         self._clock = 0.0
+
+    def _allocate(self, capacity: int) -> None:
+        """Buffers for chunks of up to ``capacity`` candidates, grown on demand."""
+        dev = self.model.device
+        for state in self._views:
+            state.allocate(capacity)
+        self._joints = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.vec3, device=dev)
+        self._rotations = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.mat33, device=dev)
+        self._vertices = wp.empty((capacity, self.model.num_vertices), dtype=wp.vec3, device=dev)
+        self._term_costs = wp.empty((capacity, len(TERM_NAMES)), dtype=wp.float32, device=dev)
+        self._costs = wp.empty(capacity, dtype=wp.float32, device=dev)
+        self._capacity = capacity
 
     def buffer_bytes(self) -> int:
         """Bytes of device memory held by this evaluator (model data excluded)."""
@@ -161,6 +175,8 @@ class PopulationEvaluator:
         pose_deg = device_array("pose_deg", pose_deg, ("P", len(POSE_NAMES)), dims, "float",
                                 wp.float32, dev)
         total = dims["P"]
+        if min(total, self.chunk_size) > self._capacity:
+            self._allocate(min(total, self.chunk_size))
         costs = np.empty(total, np.float32)
         part_costs = np.empty((total, len(TERM_NAMES)), np.float32)
         for start in range(0, total, self.chunk_size):
