@@ -104,8 +104,10 @@ class PopulationEvaluator:
         views: one :class:`ViewTarget` per view (``"front"`` and/or ``"side"``, each once).
         settings: weights and matching choices.
         chunk_size: candidates per launch (default ``DEFAULT_CHUNK`` for the device).
-        profile: synchronise after every stage and add its wall time to
-            ``stage_seconds`` (slower; for the benchmark).
+        profile: synchronise after every stage and add its time to ``stage_seconds``
+            (slower; for the benchmark): the process's CPU time on a CPU device (other
+            jobs on a shared machine do not count; Warp runs CPU kernels in the calling
+            thread), wall time on a GPU.
 
     Raises:
         ValueError: no view, a repeated view name, views on another device, or a
@@ -132,6 +134,7 @@ class PopulationEvaluator:
         self.stage_seconds = dict.fromkeys(STAGES, 0.0)
         self._views = [_ViewState(v, model, settings) for v in views]
         self._capacity = 0
+        self._timer = time.perf_counter if model.device.is_cuda else time.process_time
         self._clock = 0.0
 
     def _allocate(self, capacity: int) -> None:
@@ -155,7 +158,7 @@ class PopulationEvaluator:
     def _stage_done(self, stage: str) -> None:
         if self.profile:
             wp.synchronize_device(self.model.device)
-            now = time.perf_counter()
+            now = self._timer()
             self.stage_seconds[stage] += now - self._clock
             self._clock = now
 
@@ -187,7 +190,7 @@ class PopulationEvaluator:
 
     def _evaluate_chunk(self, betas: wp.array, pose_deg: wp.array):
         num = betas.shape[0]
-        self._clock = time.perf_counter()
+        self._clock = self._timer()
         vertices = self._vertices[:num]
         launch_skinning(self.model, betas, pose_deg, self._joints[:num], self._rotations[:num],
                         vertices)

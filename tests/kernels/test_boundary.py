@@ -9,7 +9,7 @@ import scipy.ndimage as ndi
 from scipy.spatial import cKDTree
 
 from bodyfit.kernels.boundary import nearest_boundary, scan_label_maps, unpack_runs
-from bodyfit.kernels.target import boundary_mask
+from bodyfit.kernels.target import boundary_distance, boundary_mask, prepare_view_target
 
 from kernel_scenes import FRONT_WIDTH, front_camera, random_bodies, render_masks
 
@@ -115,3 +115,15 @@ def test_empty_map_has_no_nearest_pixel():
 def test_nearest_boundary_rejects_bad_input(labels, points, message):
     with pytest.raises(ValueError, match=message):
         nearest_boundary(labels, points)
+
+
+def test_person_target_has_the_boundary_and_its_exact_distance_transform():
+    mask = blob_maps(1, seed=4)[0] >= 0
+    view = prepare_view_target("front", mask, front_camera(), 1.0)
+    boundary = boundary_mask(mask)
+    points = view.boundary_points.numpy()
+    assert np.array_equal(np.sort(points[:, 1] * 1000 + points[:, 0]),
+                          np.sort(np.nonzero(boundary)[0] * 1000 + np.nonzero(boundary)[1]))
+    exact = ndi.distance_transform_edt(~boundary)
+    assert np.abs(view.boundary_distance.numpy() - exact).max() < 1e-3
+    assert np.array_equal(boundary_distance(boundary), view.boundary_distance.numpy())
