@@ -35,6 +35,7 @@ from bodyfit.kernels.boundary import run_end, run_part, run_start, transform_poi
 
 __all__ = [
     "MATCHING_DIRECTIONS",
+    "MATCHING_WEIGHTS",
     "TERM_NAMES",
     "CostSettings",
     "CostParams",
@@ -47,7 +48,10 @@ __all__ = [
 NUM_PARTS = len(PART_NAMES)
 #: Columns of the per-term breakdown.
 TERM_NAMES = PART_NAMES + ("top", "bottom")
-MATCHING_DIRECTIONS = ("person_to_model", "model_to_person", "symmetric")
+#: Matching direction -> weights of the (person -> model, model -> person) means.
+MATCHING_WEIGHTS = {"person_to_model": (1.0, 0.0), "model_to_person": (0.0, 1.0),
+                    "symmetric": (0.5, 0.5)}
+MATCHING_DIRECTIONS = tuple(MATCHING_WEIGHTS)
 
 PartVector = wp.types.vector(length=NUM_PARTS, dtype=wp.float32)
 
@@ -117,10 +121,7 @@ def cost_params(settings: CostSettings, view_name: str,
     params.top_weight = settings.top_weight
     params.bottom_weight = settings.bottom_weight
     params.scale = settings.view_weight(view_name) * millimetres_per_pixel
-    forward, backward = {"person_to_model": (1.0, 0.0), "model_to_person": (0.0, 1.0),
-                         "symmetric": (0.5, 0.5)}[settings.matching]
-    params.person_to_model = forward
-    params.model_to_person = backward
+    params.person_to_model, params.model_to_person = MATCHING_WEIGHTS[settings.matching]
     return params
 
 

@@ -19,7 +19,7 @@ from typing import NamedTuple, Sequence
 import numpy as np
 import warp as wp
 
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES
+from bodyfit.fitter.body_model import POSE_NAMES
 from bodyfit.kernels.alignment import launch_alignment
 from bodyfit.kernels.boundary import BoundaryRuns, allocate_runs, launch_nearest, launch_row_scan
 from bodyfit.kernels.cost import (TERM_NAMES, CostSettings, PartVector, cost_params,
@@ -27,7 +27,7 @@ from bodyfit.kernels.cost import (TERM_NAMES, CostSettings, PartVector, cost_par
 from bodyfit.kernels.device import device_array
 from bodyfit.kernels.raster import launch_projection, launch_raster
 from bodyfit.kernels.skinning import ModelArrays, launch_skinning
-from bodyfit.kernels.target import ViewTarget
+from bodyfit.kernels.target import ViewTarget, visible_faces
 
 __all__ = ["STAGES", "PopulationCost", "PopulationEvaluator", "evaluate_population"]
 
@@ -58,13 +58,11 @@ class _ViewState:
 
     def __init__(self, view: ViewTarget, model: ModelArrays, settings: CostSettings):
         dev = model.device
-        ids = [PART_NAMES.index(name) for name in view.visible_parts]
-        keep = np.isin(model.face_parts, ids)
+        faces, face_parts = visible_faces(model.faces, model.face_parts, view.visible_parts)
         self.view = view
         self.num_vertices = model.num_vertices
-        self.faces = wp.array(model.faces[keep], dtype=wp.vec3i, device=dev)
-        self.face_parts = wp.array(model.face_parts[keep].astype(np.int32), dtype=wp.int32,
-                                   device=dev)
+        self.faces = wp.array(faces, dtype=wp.vec3i, device=dev)
+        self.face_parts = wp.array(face_parts.astype(np.int32), dtype=wp.int32, device=dev)
         self.params = cost_params(settings, view.name, view.millimetres_per_pixel)
         self.frame = view.target_frame
 

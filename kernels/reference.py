@@ -25,8 +25,8 @@ from scipy.spatial import cKDTree
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel, forward
 from bodyfit.kernels.alignment import rigid_transform, silhouette_frame
 from bodyfit.kernels.camera import Camera, camera_matrices
-from bodyfit.kernels.cost import TERM_NAMES, CostSettings
-from bodyfit.kernels.target import ViewTarget, boundary_mask
+from bodyfit.kernels.cost import MATCHING_WEIGHTS, TERM_NAMES, CostSettings
+from bodyfit.kernels.target import ViewTarget, boundary_mask, visible_faces
 
 __all__ = ["project_vertices", "render_label_maps", "interpolate_distance", "view_terms",
            "population_cost"]
@@ -127,8 +127,7 @@ def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) 
         distances = interpolate_distance(view.boundary_distance.numpy(), moved)
         np.add.at(backward_sums, model_parts, distances)
         backward_sums /= len(model_points)
-    mix = {"person_to_model": (1.0, 0.0), "model_to_person": (0.0, 1.0),
-           "symmetric": (0.5, 0.5)}[settings.matching]
+    mix = MATCHING_WEIGHTS[settings.matching]
     parts = weights * (mix[0] * forward_sums + mix[1] * backward_sums)
     top = abs((to_person[:2, :2] @ frame.top + to_person[:2, 2] - view.frame.top)[1])
     bottom = abs((to_person[:2, :2] @ frame.bottom + to_person[:2, 2] - view.frame.bottom)[1])
@@ -144,9 +143,9 @@ def population_cost(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     vertices = forward(model, betas, pose_deg)
     part_costs = np.zeros((len(betas), len(TERM_NAMES)))
     for view in views:
-        keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in view.visible_parts])
+        faces, face_parts = visible_faces(model.faces, model.face_parts, view.visible_parts)
         screen = project_vertices(view.camera, vertices)
-        maps = render_label_maps(screen, model.faces[keep], model.face_parts[keep],
-                                 view.height, view.width, supersample)
+        maps = render_label_maps(screen, faces, face_parts, view.height, view.width,
+                                 supersample)
         part_costs += np.stack([view_terms(m, view, settings) for m in maps])
     return part_costs.sum(axis=1), part_costs

@@ -21,7 +21,7 @@ from bodyfit.kernels.camera import Camera
 from bodyfit.kernels.device import resolve_device
 
 __all__ = ["VIEW_NAMES", "SIDE_VIEW_PARTS", "ViewTarget", "prepare_view_target",
-           "boundary_mask", "boundary_distance"]
+           "visible_faces", "boundary_mask", "boundary_distance"]
 
 #: The two views of the paper, in the order their weights appear in Table 2.
 VIEW_NAMES = ("front", "side")
@@ -29,6 +29,14 @@ VIEW_NAMES = ("front", "side")
 #: the body, so no arm silhouette appears there, while the model's A-pose arms hang forward
 #: (and its four pose angles cannot swing them back): arm, elbow and hand are left out.
 SIDE_VIEW_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
+
+def visible_faces(faces: np.ndarray, face_parts: np.ndarray,
+                  visible_parts) -> tuple[np.ndarray, np.ndarray]:
+    """The (F', 3) faces and (F',) parts of the faces whose part is named in
+    ``visible_parts`` (names from ``PART_NAMES``)."""
+    keep = np.isin(face_parts, [PART_NAMES.index(name) for name in visible_parts])
+    return faces[keep], face_parts[keep]
+
 
 _CROSS = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))
 

@@ -33,7 +33,8 @@ from bodyfit.kernels.population import STAGES, PopulationEvaluator
 from bodyfit.kernels.raster import rasterize
 from bodyfit.kernels.reference import population_cost
 from bodyfit.kernels.skinning import ModelArrays
-from bodyfit.kernels.target import SIDE_VIEW_PARTS, boundary_mask, prepare_view_target
+from bodyfit.kernels.target import (SIDE_VIEW_PARTS, boundary_mask, prepare_view_target,
+                                    visible_faces)
 
 CPU_TARGET_MS = 2.0
 REFERENCE_TARGET_RATIO = 10.0
@@ -55,9 +56,9 @@ def _views(model, height: int, device: str, seed: int):
         centre_u = width / 2 - ppm * (mean[:, axis].max() + mean[:, axis].min()) / 2
         centre_v = height / 2 + ppm * (mean[:, 2].max() + mean[:, 2].min()) / 2
         camera = orthographic_camera(view_deg, ppm, (centre_u, centre_v))
-        keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in parts])
-        mask = rasterize(forward(model, betas, pose), model.faces[keep], model.face_parts[keep],
-                         camera, height, width).numpy()[0] >= 0
+        faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
+        mask = rasterize(forward(model, betas, pose), faces, face_parts, camera, height,
+                         width).numpy()[0] >= 0
         views.append(prepare_view_target(name, mask, camera, 1000.0 / ppm, parts, device))
     return views, (betas, pose)
 
@@ -121,7 +122,7 @@ def main() -> None:
           f"({views[0].boundary_points.shape[0]} person boundary points), side "
           f"{views[1].width} px ({views[1].boundary_points.shape[0]}); "
           f"{model.faces.shape[0]} triangles front, "
-          f"{int(np.isin(model.face_parts, [PART_NAMES.index(p) for p in SIDE_VIEW_PARTS]).sum())} "
+          f"{len(visible_faces(model.faces, model.face_parts, SIDE_VIEW_PARTS)[0])} "
           f"side; {model.num_vertices} vertices; matching {settings.matching}.\n")
     header = "| P | " + " | ".join(f"{s} (cv/s)" for s in STAGES)
     print(header + " | total (cv/s) | ms per cv | late generation (cv/s) | buffers (MB) | peak RSS (MB) |")

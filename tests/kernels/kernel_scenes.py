@@ -9,6 +9,7 @@ import warp as wp
 from bodyfit.fitter.body_model import PART_NAMES, forward
 from bodyfit.kernels.camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.raster import rasterize
+from bodyfit.kernels.target import visible_faces
 
 #: The canvas of the tests: 512 px high like the benchmark; widths fit each view.
 HEIGHT = 512
@@ -31,12 +32,6 @@ def side_camera():
     return orthographic_camera(SIDE_VIEW_DEG, PIXELS_PER_METRE, (SIDE_WIDTH / 2, HEIGHT / 2))
 
 
-def part_subset(body_model, parts):
-    """(faces, face_parts) of the model's faces whose part is in ``parts``."""
-    keep = np.isin(body_model.face_parts, [PART_NAMES.index(p) for p in parts])
-    return body_model.faces[keep], body_model.face_parts[keep]
-
-
 def random_bodies(num: int, seed: int, spread: float = 2.0):
     """(betas (num, 20), pose_deg (num, 4)) float32 within +-spread sigma and 0-30 degrees."""
     rng = np.random.default_rng(seed)
@@ -44,9 +39,9 @@ def random_bodies(num: int, seed: int, spread: float = 2.0):
             rng.uniform(0.0, 30.0, (num, 4)).astype(np.float32))
 
 
-def render_masks(body_model, betas, pose_deg, camera, width, parts=PART_NAMES):
+def render_labels(body_model, betas, pose_deg, camera, width, parts=PART_NAMES):
     """(P, H, W) int8 label maps of bodies, by the kernel rasteriser."""
-    faces, face_parts = part_subset(body_model, parts)
+    faces, face_parts = visible_faces(body_model.faces, body_model.face_parts, parts)
     vertices = forward(body_model, betas, pose_deg)
     return rasterize(vertices, faces, face_parts, camera, HEIGHT, width).numpy()
 

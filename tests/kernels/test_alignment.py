@@ -9,7 +9,7 @@ from bodyfit.kernels.alignment import align_label_maps, rigid_transform, silhoue
 from bodyfit.kernels.camera import orthographic_camera
 from bodyfit.kernels.target import boundary_mask
 
-from kernel_scenes import FRONT_WIDTH, HEIGHT, PIXELS_PER_METRE, random_bodies, render_masks
+from kernel_scenes import FRONT_WIDTH, HEIGHT, PIXELS_PER_METRE, random_bodies, render_labels
 
 CENTRE = np.array([FRONT_WIDTH / 2, HEIGHT / 2])
 SCALE = 0.85 * PIXELS_PER_METRE  # margin for the moved silhouettes to stay in the canvas
@@ -23,10 +23,10 @@ def _moved_camera(roll_deg: float, shift_px):
 @pytest.fixture(scope="module")
 def person_and_moved(body_model):
     betas, pose = random_bodies(1, seed=7)
-    person = render_masks(body_model, betas, pose, _moved_camera(0.0, (0, 0)), FRONT_WIDTH)[0]
-    moved = render_masks(body_model, np.repeat(betas, 2, 0), np.repeat(pose, 2, 0),
+    person = render_labels(body_model, betas, pose, _moved_camera(0.0, (0, 0)), FRONT_WIDTH)[0]
+    moved = render_labels(body_model, np.repeat(betas, 2, 0), np.repeat(pose, 2, 0),
                          _moved_camera(4.0, (11.3, -6.7)), FRONT_WIDTH)
-    moved[1] = render_masks(body_model, betas, pose, _moved_camera(0.0, (-8.4, 5.2)),
+    moved[1] = render_labels(body_model, betas, pose, _moved_camera(0.0, (-8.4, 5.2)),
                             FRONT_WIDTH)[0]
     return person, moved
 

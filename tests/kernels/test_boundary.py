@@ -11,7 +11,7 @@ from scipy.spatial import cKDTree
 from bodyfit.kernels.boundary import nearest_boundary, scan_label_maps, unpack_runs
 from bodyfit.kernels.target import boundary_distance, boundary_mask, prepare_view_target
 
-from kernel_scenes import FRONT_WIDTH, front_camera, random_bodies, render_masks
+from kernel_scenes import FRONT_WIDTH, front_camera, random_bodies, render_labels
 
 
 def blob_maps(num: int, height: int = 96, width: int = 128, seed: int = 0) -> np.ndarray:
@@ -33,7 +33,7 @@ def blob_maps(num: int, height: int = 96, width: int = 128, seed: int = 0) -> np
 
 @pytest.fixture(scope="module")
 def body_maps(body_model):
-    return render_masks(body_model, *random_bodies(2, seed=6), front_camera(), FRONT_WIDTH)
+    return render_labels(body_model, *random_bodies(2, seed=6), front_camera(), FRONT_WIDTH)
 
 
 def _boundary_parts(labels: np.ndarray) -> np.ndarray:

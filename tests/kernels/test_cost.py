@@ -14,7 +14,7 @@ from bodyfit.kernels.skinning import ModelArrays
 from bodyfit.kernels.target import SIDE_VIEW_PARTS, prepare_view_target
 
 from kernel_scenes import (DEVICES, FRONT_WIDTH, PIXELS_PER_METRE, SIDE_WIDTH, front_camera,
-                           random_bodies, render_masks, side_camera)
+                           random_bodies, render_labels, side_camera)
 
 MM_PER_PX = 1000.0 / PIXELS_PER_METRE
 
@@ -26,8 +26,8 @@ def truth():
 
 def _views(body_model, betas, pose, device="cpu", side_parts=SIDE_VIEW_PARTS):
     """Front and side views of a person who is the body (betas, pose)."""
-    front = render_masks(body_model, betas, pose, front_camera(), FRONT_WIDTH)[0] >= 0
-    side = render_masks(body_model, betas, pose, side_camera(), SIDE_WIDTH, side_parts)[0] >= 0
+    front = render_labels(body_model, betas, pose, front_camera(), FRONT_WIDTH)[0] >= 0
+    side = render_labels(body_model, betas, pose, side_camera(), SIDE_WIDTH, side_parts)[0] >= 0
     return [prepare_view_target("front", front, front_camera(), MM_PER_PX, device=device),
             prepare_view_target("side", side, side_camera(), MM_PER_PX, side_parts, device)]
 
@@ -51,7 +51,7 @@ def test_cost_terms_equal_the_numpy_formula(body_model, model_arrays, views, can
     expected = np.zeros_like(part_costs, dtype=np.float64)
     for view, camera, width in zip(views, (front_camera(), side_camera()),
                                    (FRONT_WIDTH, SIDE_WIDTH)):
-        maps = render_masks(body_model, *candidates, camera, width, view.visible_parts)
+        maps = render_labels(body_model, *candidates, camera, width, view.visible_parts)
         expected += np.stack([view_terms(m, view, settings) for m in maps])
     assert part_costs.shape == (5, len(TERM_NAMES))
     assert np.allclose(costs, part_costs.sum(axis=1), rtol=1e-5)
