@@ -3,8 +3,8 @@
 Per view, once: the boundary pixels of the person's mask (the points z_i of the paper's
 Eq. 15 and 18), the exact Euclidean distance transform of that boundary (for the
 model -> person matching direction), and the silhouette's moments and top/bottom points
-(for the alignment and the paper's highest- and lowest-point terms). Host-side NumPy and
-OpenCV; the results go to the device once.
+(for the alignment and the paper's highest- and lowest-point terms). Host-side NumPy,
+OpenCV and SciPy; the results go to the device once.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import dataclasses
 
 import cv2
 import numpy as np
+import scipy.ndimage as ndi
 import warp as wp
 
 from bodyfit.fitter.body_model import PART_NAMES
@@ -54,9 +55,12 @@ def boundary_mask(mask: np.ndarray) -> np.ndarray:
 
 def boundary_distance(boundary: np.ndarray) -> np.ndarray:
     """(H, W) float32 exact Euclidean distance (pixels) from every pixel centre to the
-    nearest True pixel of a (H, W) bool ``boundary`` (OpenCV, DIST_MASK_PRECISE)."""
-    source = np.where(np.asarray(boundary, dtype=bool), 0, 255).astype(np.uint8)
-    return cv2.distanceTransform(source, cv2.DIST_L2, cv2.DIST_MASK_PRECISE).astype(np.float32)
+    nearest True pixel of a (H, W) bool ``boundary``.
+
+    SciPy's exact transform, not OpenCV's: ``cv2.distanceTransform`` is multithreaded and
+    its results differ in the last bit from call to call, which would make runs differ.
+    """
+    return ndi.distance_transform_edt(~np.asarray(boundary, dtype=bool)).astype(np.float32)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
