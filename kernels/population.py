@@ -1,0 +1,246 @@
+"""Scoring whole populations against the person's views: the kernels' entry point.
+
+    model = ModelArrays.from_body_model(load_model(), num_betas=20, device="cpu")
+    views = [prepare_view_target("front", front_mask, front_camera, mm_per_px), ...]
+    evaluator = PopulationEvaluator(model, views, CostSettings())
+    costs, part_costs = evaluator.evaluate(betas, pose_deg)     # every generation
+
+For each chunk of candidates: skin once; then per view: project, rasterise into label
+maps, row-scan the boundaries, align to the person, match the boundaries, and add the
+view's weighted terms. The optimiser never sees the kernels: it asks for a population,
+the caller evaluates it here, and tells the optimiser the costs.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import NamedTuple, Sequence
+
+import numpy as np
+import warp as wp
+
+from bodyfit.fitter.body_model import POSE_NAMES
+from bodyfit.kernels.alignment import launch_alignment
+from bodyfit.kernels.boundary import BoundaryRuns, allocate_runs, launch_nearest, launch_row_scan
+from bodyfit.kernels.cost import (TERM_NAMES, CostSettings, PartVector, cost_params,
+                                  launch_model_to_person, launch_view_cost)
+from bodyfit.kernels.device import device_array
+from bodyfit.kernels.raster import launch_projection, launch_raster
+from bodyfit.kernels.skinning import ModelArrays, launch_skinning
+from bodyfit.kernels.target import ViewTarget, visible_faces
+
+__all__ = ["STAGES", "PopulationCost", "PopulationEvaluator", "evaluate_population"]
+
+#: Stages timed by ``PopulationEvaluator(profile=True)``.
+STAGES = ("skin", "raster", "distance", "cost")
+
+#: Candidates per kernel launch: tens on a CPU (bounded memory, maps near the cache),
+#: thousands on a GPU (enough threads to fill it).
+DEFAULT_CHUNK = {"cpu": 32, "cuda": 4096}
+
+
+class PopulationCost(NamedTuple):
+    """Costs of a population.
+
+    Attributes:
+        costs: (P,) float32, weighted millimetres (Eq. 17); +inf for a candidate whose
+            silhouette is empty in a view.
+        part_costs: (P, 11) float32, the terms in ``TERM_NAMES`` order (nine parts, top,
+            bottom), summed over the views with their weights; rows sum to ``costs``.
+    """
+
+    costs: np.ndarray
+    part_costs: np.ndarray
+
+
+class _ViewState:
+    """A view's constant device data and its per-chunk buffers."""
+
+    def __init__(self, view: ViewTarget, model: ModelArrays, settings: CostSettings):
+        dev = model.device
+        faces, face_parts = visible_faces(model.faces, model.face_parts, view.visible_parts)
+        self.view = view
+        self.num_vertices = model.num_vertices
+        self.faces = wp.array(faces, dtype=wp.vec3i, device=dev)
+        self.face_parts = wp.array(face_parts.astype(np.int32), dtype=wp.int32, device=dev)
+        self.params = cost_params(settings, view.name, view.millimetres_per_pixel)
+        self.frame = view.target_frame
+
+    def allocate(self, chunk: int) -> None:
+        """(Re)allocate the buffers for chunks of up to ``chunk`` candidates."""
+        view, dev = self.view, self.faces.device
+        num_points = view.boundary_points.shape[0]
+        size = (chunk, view.height, view.width)
+        self.screen = wp.empty((chunk, self.num_vertices), dtype=wp.vec3, device=dev)
+        self.keys = wp.empty(size, dtype=wp.int32, device=dev)
+        self.scan = allocate_runs(*size, dev)
+        self.transforms = wp.empty(chunk, dtype=wp.mat33, device=dev)
+        self.extremes = wp.empty((chunk, 2), dtype=wp.vec2, device=dev)
+        self.areas = wp.empty(chunk, dtype=wp.float32, device=dev)
+        self.distances = wp.empty((chunk, num_points), dtype=wp.float32, device=dev)
+        self.parts = wp.empty((chunk, num_points), dtype=wp.int32, device=dev)
+        self.row_sums = wp.empty((chunk, view.height), dtype=PartVector, device=dev)
+        self.row_pixels = wp.empty((chunk, view.height), dtype=wp.int32, device=dev)
+
+    def arrays(self) -> list[wp.array]:
+        return [v for v in (*vars(self).values(), *vars(self.scan).values())
+                if isinstance(v, wp.array)]
+
+    def scan_rows(self, num: int) -> BoundaryRuns:
+        return BoundaryRuns(self.scan.runs[:num], self.scan.run_counts[:num],
+                            self.scan.row_moments[:num])
+
+
+class PopulationEvaluator:
+    """Evaluates populations of (betas, pose) against one person's views.
+
+    Device buffers are allocated by the first :meth:`evaluate` (for min(P, chunk size)
+    candidates), grown if a later population needs more, and otherwise reused.
+
+    Args:
+        model: the body model on the device the views were prepared for.
+        views: one :class:`ViewTarget` per view (``"front"`` and/or ``"side"``, each once).
+        settings: weights and matching choices.
+        chunk_size: candidates per launch (default ``DEFAULT_CHUNK`` for the device).
+        profile: synchronise after every stage and add its time to ``stage_seconds``
+            (slower; for the benchmark): the process's CPU time on a CPU device (other
+            jobs on a shared machine do not count; Warp runs CPU kernels in the calling
+            thread), wall time on a GPU.
+
+    Raises:
+        ValueError: no view, a repeated view name, views on another device, or a
+            chunk size < 1.
+    """
+
+    def __init__(self, model: ModelArrays, views: Sequence[ViewTarget],
+                 settings: CostSettings = CostSettings(), chunk_size: int | None = None,
+                 profile: bool = False):
+        names = [v.name for v in views]
+        if not views or len(set(names)) != len(names):
+            raise ValueError(f"views must be one or more distinct views, got {names}")
+        for view in views:
+            if view.boundary_points.device != model.device:
+                raise ValueError(f"view {view.name!r} was prepared on "
+                                 f"{view.boundary_points.device}, the model is on {model.device}")
+        chunk = chunk_size or DEFAULT_CHUNK["cuda" if model.device.is_cuda else "cpu"]
+        if chunk < 1:
+            raise ValueError(f"chunk_size must be >= 1, got {chunk}")
+        self.model = model
+        self.settings = settings
+        self.chunk_size = chunk
+        self.profile = profile
+        self.stage_seconds = dict.fromkeys(STAGES, 0.0)
+        self._views = [_ViewState(v, model, settings) for v in views]
+        self._capacity = 0
+        self._timer = time.perf_counter if model.device.is_cuda else time.process_time
+        self._clock = 0.0
+
+    def _allocate(self, capacity: int) -> None:
+        """Buffers for chunks of up to ``capacity`` candidates, grown on demand."""
+        dev = self.model.device
+        for state in self._views:
+            state.allocate(capacity)
+        self._joints = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.vec3, device=dev)
+        self._rotations = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.mat33, device=dev)
+        self._vertices = wp.empty((capacity, self.model.num_vertices), dtype=wp.vec3, device=dev)
+        self._term_costs = wp.empty((capacity, len(TERM_NAMES)), dtype=wp.float32, device=dev)
+        self._costs = wp.empty(capacity, dtype=wp.float32, device=dev)
+        self._capacity = capacity
+
+    def buffer_bytes(self) -> int:
+        """Bytes of device memory held by this evaluator (model data excluded)."""
+        arrays = [v for v in vars(self).values() if isinstance(v, wp.array)]
+        arrays += [a for state in self._views for a in state.arrays()]
+        return sum(a.capacity for a in arrays)
+
+    def _stage_done(self, stage: str) -> None:
+        if self.profile:
+            wp.synchronize_device(self.model.device)
+            now = self._timer()
+            self.stage_seconds[stage] += now - self._clock
+            self._clock = now
+
+    def evaluate(self, betas, pose_deg) -> PopulationCost:
+        """Costs and per-term costs of P candidates.
+
+        Args:
+            betas: (P, K) float, shape coefficients in units of standard deviation.
+            pose_deg: (P, 4) float, abduction angles in degrees, ``POSE_NAMES`` order.
+
+        Raises:
+            ValueError: wrong shapes or dtypes.
+        """
+        dev = self.model.device
+        dims = {"K": self.model.num_betas}
+        betas = device_array("betas", betas, ("P", "K"), dims, "float", wp.float32, dev)
+        pose_deg = device_array("pose_deg", pose_deg, ("P", len(POSE_NAMES)), dims, "float",
+                                wp.float32, dev)
+        total = dims["P"]
+        if min(total, self.chunk_size) > self._capacity:
+            self._allocate(min(total, self.chunk_size))
+        costs = np.empty(total, np.float32)
+        part_costs = np.empty((total, len(TERM_NAMES)), np.float32)
+        for start in range(0, total, self.chunk_size):
+            stop = min(start + self.chunk_size, total)
+            costs[start:stop], part_costs[start:stop] = self._evaluate_chunk(
+                betas[start:stop], pose_deg[start:stop])
+        return PopulationCost(costs, part_costs)
+
+    def _evaluate_chunk(self, betas: wp.array, pose_deg: wp.array):
+        num = betas.shape[0]
+        self._clock = self._timer()
+        vertices = self._vertices[:num]
+        launch_skinning(self.model, betas, pose_deg, self._joints[:num], self._rotations[:num],
+                        vertices)
+        term_costs, costs = self._term_costs[:num], self._costs[:num]
+        term_costs.zero_()
+        costs.zero_()
+        self._stage_done("skin")
+        for state in self._views:
+            self._evaluate_view(state, vertices, term_costs, costs)
+        out = costs.numpy(), term_costs.numpy()
+        self._stage_done("cost")
+        return out
+
+    def _evaluate_view(self, state: _ViewState, vertices: wp.array, term_costs: wp.array,
+                       costs: wp.array) -> None:
+        num = vertices.shape[0]
+        view = state.view
+        screen, keys = state.screen[:num], state.keys[:num]
+        launch_projection(view.camera, vertices, screen)
+        launch_raster(view.camera, screen, state.faces, state.face_parts, keys)
+        self._stage_done("raster")
+        scan = state.scan_rows(num)
+        transforms, extremes, areas = state.transforms[:num], state.extremes[:num], state.areas[:num]
+        distances, parts = state.distances[:num], state.parts[:num]
+        row_sums, row_pixels = state.row_sums[:num], state.row_pixels[:num]
+        launch_row_scan(keys, scan)
+        launch_alignment(scan.row_moments, state.frame, self.settings.align_rotation,
+                         transforms, extremes, areas)
+        if state.params.person_to_model > 0:
+            launch_nearest(scan, view.boundary_points, transforms, distances, parts)
+        if state.params.model_to_person > 0:
+            launch_model_to_person(scan.runs, scan.run_counts, transforms, view.boundary_distance,
+                                   row_sums, row_pixels)
+        self._stage_done("distance")
+        launch_view_cost(state.params, state.frame, distances, parts, row_sums, row_pixels,
+                         transforms, extremes, areas, term_costs, costs)
+        self._stage_done("cost")
+
+
+def evaluate_population(model: ModelArrays, views: Sequence[ViewTarget], betas, pose_deg,
+                        settings: CostSettings = CostSettings()) -> PopulationCost:
+    """One-off :meth:`PopulationEvaluator.evaluate` (an optimiser loop should keep one
+    :class:`PopulationEvaluator` and call it every generation).
+
+    Args:
+        model: the body model on the views' device.
+        views: the person's prepared views.
+        betas: (P, K) float, units of sigma.
+        pose_deg: (P, 4) float, degrees, ``POSE_NAMES`` order.
+        settings: weights and matching choices.
+
+    Returns:
+        ``PopulationCost(costs (P,), part_costs (P, 11))``.
+    """
+    return PopulationEvaluator(model, views, settings).evaluate(betas, pose_deg)

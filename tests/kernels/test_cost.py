@@ -1,0 +1,155 @@
+"""The weighted cost (Eq. 17-18) and the evaluator against the NumPy/OpenCV reference."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from bodyfit.fitter.body_model import PART_NAMES
+from bodyfit.kernels.camera import orthographic_camera
+from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
+from bodyfit.kernels.population import PopulationEvaluator, evaluate_population
+from bodyfit.kernels.reference import population_cost, view_terms
+from bodyfit.kernels.skinning import ModelArrays
+from bodyfit.kernels.target import SIDE_VIEW_PARTS, prepare_view_target
+
+from kernel_scenes import (DEVICES, FRONT_WIDTH, PIXELS_PER_METRE, SIDE_WIDTH, front_camera,
+                           random_bodies, render_labels, side_camera)
+
+MM_PER_PX = 1000.0 / PIXELS_PER_METRE
+
+
+@pytest.fixture(scope="module")
+def truth():
+    return random_bodies(1, seed=11, spread=1.5)
+
+
+def _views(body_model, betas, pose, device="cpu", side_parts=SIDE_VIEW_PARTS):
+    """Front and side views of a person who is the body (betas, pose)."""
+    front = render_labels(body_model, betas, pose, front_camera(), FRONT_WIDTH)[0] >= 0
+    side = render_labels(body_model, betas, pose, side_camera(), SIDE_WIDTH, side_parts)[0] >= 0
+    return [prepare_view_target("front", front, front_camera(), MM_PER_PX, device=device),
+            prepare_view_target("side", side, side_camera(), MM_PER_PX, side_parts, device)]
+
+
+@pytest.fixture(scope="module")
+def views(body_model, truth):
+    return _views(body_model, *truth)
+
+
+@pytest.fixture(scope="module")
+def candidates(truth):
+    betas, pose = random_bodies(4, seed=12, spread=1.5)
+    return np.concatenate([truth[0], betas]), np.concatenate([truth[1], pose])
+
+
+@pytest.mark.parametrize("matching", MATCHING_DIRECTIONS)
+def test_cost_terms_equal_the_numpy_formula(body_model, model_arrays, views, candidates,
+                                            matching):
+    settings = CostSettings(matching=matching)
+    costs, part_costs = evaluate_population(model_arrays, views, *candidates, settings)
+    expected = np.zeros_like(part_costs, dtype=np.float64)
+    for view, camera, width in zip(views, (front_camera(), side_camera()),
+                                   (FRONT_WIDTH, SIDE_WIDTH)):
+        maps = render_labels(body_model, *candidates, camera, width, view.visible_parts)
+        expected += np.stack([view_terms(m, view, settings) for m in maps])
+    assert part_costs.shape == (5, len(TERM_NAMES))
+    assert np.allclose(costs, part_costs.sum(axis=1), rtol=1e-5)
+    assert np.allclose(costs, expected.sum(axis=1), rtol=1e-4, atol=1e-2)
+    # parts can differ only where a person point is equally far from two candidate parts
+    assert np.allclose(part_costs, expected, rtol=1e-3, atol=0.02 * costs.max())
+    assert costs[0] < 1e-3 and (costs[1:] > 100).all()
+
+
+def test_cost_grows_away_from_the_true_body(model_arrays, views, truth):
+    rng = np.random.default_rng(13)
+    direction = rng.normal(size=(1, 20)).astype(np.float32)
+    steps = np.array([0.0, 0.1, 0.3, 0.9], np.float32)[:, None]
+    betas = truth[0] + steps * direction
+    costs, _ = evaluate_population(model_arrays, views, betas, np.repeat(truth[1], 4, 0))
+    assert costs[0] < 1e-3 and np.all(np.diff(costs) > 0)
+
+
+def test_evaluator_matches_the_reference_pipeline(body_model, model_arrays, views, candidates):
+    betas, pose = candidates[0][1:3], candidates[1][1:3]
+    costs, part_costs = evaluate_population(model_arrays, views, betas, pose)
+    expected, expected_parts = population_cost(body_model, betas, pose, views, supersample=65)
+    assert np.allclose(costs, expected, rtol=0.02)
+    assert np.abs(part_costs - expected_parts).max() < 0.05 * costs.min()
+
+
+def test_side_view_leaves_out_arms_held_against_the_body(body_model, model_arrays, truth):
+    """A person photographed from the side with the hands against the body shows no arm
+    silhouette. Rendering the model's A-pose arms, which hang forward, puts an artefact
+    into the side cost of the true body (it shifts the alignment, so the torso and
+    stature terms pay too); leaving the arms out of the side view does not."""
+    views = _views(body_model, *truth)
+    with_arms = [views[0], prepare_view_target("side", views[1].silhouette, side_camera(),
+                                               MM_PER_PX)]
+    for matching in MATCHING_DIRECTIONS:
+        settings = CostSettings(matching=matching)
+        default = evaluate_population(model_arrays, views, *truth, settings).costs[0]
+        artefact = evaluate_population(model_arrays, with_arms, *truth, settings).part_costs[0]
+        assert default < 1e-3
+        assert artefact.sum() > 300.0 and artefact[TERM_NAMES.index("chest")] > 20.0
+
+
+def test_chunks_do_not_change_the_costs(model_arrays, views, candidates):
+    whole = PopulationEvaluator(model_arrays, views, chunk_size=8).evaluate(*candidates)
+    chunked = PopulationEvaluator(model_arrays, views, chunk_size=2).evaluate(*candidates)
+    assert np.array_equal(whole.costs, chunked.costs)
+    assert np.array_equal(whole.part_costs, chunked.part_costs)
+
+
+def test_profile_times_every_stage(model_arrays, views, candidates):
+    evaluator = PopulationEvaluator(model_arrays, views, profile=True)
+    evaluator.evaluate(*candidates)
+    assert all(seconds > 0 for seconds in evaluator.stage_seconds.values())
+
+
+def test_empty_silhouette_costs_infinity(model_arrays, views, truth):
+    off_canvas = orthographic_camera((90.0, 0.0, 0.0), PIXELS_PER_METRE, (-5000.0, -5000.0))
+    view = prepare_view_target("front", views[0].silhouette, off_canvas, MM_PER_PX)
+    costs, part_costs = evaluate_population(model_arrays, [view], *truth)
+    assert np.isinf(costs).all() and np.isinf(part_costs).all()
+
+
+@pytest.mark.parametrize("device", DEVICES)
+def test_costs_are_the_same_on_every_device(body_model, model_arrays, views, truth,
+                                            candidates, device):
+    model = ModelArrays.from_body_model(body_model, num_betas=20, device=device)
+    costs = evaluate_population(model, _views(body_model, *truth, device=device), *candidates)
+    on_cpu = evaluate_population(model_arrays, views, *candidates)
+    assert np.allclose(costs.costs, on_cpu.costs, rtol=1e-5)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(matching="both"), "matching must be one of"),
+    (dict(part_weights=(1.0,) * 8), "part_weights needs 9 values"),
+    (dict(top_weight=-1.0), ">= 0"),
+])
+def test_settings_reject_bad_values(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        CostSettings(**kwargs)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(name="back"), "name must be one of"),
+    (dict(mask=np.zeros((4, 4), bool)), "mask is empty"),
+    (dict(mask=np.ones((2, 4, 4), bool)), r"mask must be a \(H, W\) bool array"),
+    (dict(visible_parts=("tail",)), "visible_parts must be a non-empty subset"),
+    (dict(millimetres_per_pixel=0.0), "millimetres_per_pixel must be > 0"),
+])
+def test_view_target_rejects_bad_input(kwargs, message):
+    args = dict(name="front", mask=np.ones((4, 4), bool), camera=front_camera(),
+                millimetres_per_pixel=1.0, visible_parts=PART_NAMES)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=message):
+        prepare_view_target(**args)
+
+
+def test_evaluator_rejects_bad_views_and_populations(model_arrays, views):
+    with pytest.raises(ValueError, match="distinct views"):
+        PopulationEvaluator(model_arrays, [views[0], views[0]])
+    with pytest.raises(ValueError, match=r"pose_deg must have shape \(P=2, 4\)"):
+        PopulationEvaluator(model_arrays, views).evaluate(np.zeros((2, 20)), np.zeros((3, 4)))
