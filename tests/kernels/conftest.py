@@ -1,17 +1,10 @@
-"""Fixtures of the kernel tests: the real body model, loaded once."""
+"""Fixtures of the kernel tests (``body_model`` comes from tests/conftest.py)."""
 
 from __future__ import annotations
 
 import pytest
 
-from bodyfit.fitter.model_cache import load_model
 from bodyfit.kernels.skinning import ModelArrays
-
-
-@pytest.fixture(scope="session")
-def body_model():
-    """The cached body model (``$BODYFIT_CACHE_DIR``; built on first use)."""
-    return load_model()
 
 
 @pytest.fixture(scope="session")
