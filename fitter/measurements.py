@@ -152,18 +152,22 @@ class Measurer:
         key = f"ring:{joint}.{side}" if side else f"ring:{joint}"
         return vertices[self.landmarks[key]].astype(np.float64).mean(axis=0)
 
-    def _limb_girths(self, vertices: np.ndarray, limb: str, fractions: np.ndarray,
-                     reduce) -> float:
-        """Mean over both sides of ``reduce`` over girths perpendicular to the limb axis at
-        ``fractions`` (0 = proximal ring centroid, 1 = distal) of the axis."""
+    def _limb_girths(self, vertices: np.ndarray, limb: str, fractions, reduce) -> float:
+        """Mean over both sides of ``reduce`` over girths perpendicular to the limb axis.
+
+        The planes cross the axis (0 = proximal ring centroid, 1 = distal) at
+        ``fractions``: an (n,) array, or a function (proximal (3,), distal (3,), side
+        index) -> (n,) array for planes placed per side.
+        """
         spec = _LIMBS[limb]
         values = []
-        for side in _SIDES:
+        for i, side in enumerate(_SIDES):
             top = self._ring(vertices, spec.upper_ring, side)
             bottom = self._ring(vertices, spec.lower_ring, side)
             axis = bottom - top
-            origins = top + np.outer(fractions, axis)
-            girths = tape_lengths(vertices, self._edges[f"{limb}.{side}"], origins, axis)
+            where = np.atleast_1d(fractions(top, bottom, i) if callable(fractions) else fractions)
+            girths = tape_lengths(vertices, self._edges[f"{limb}.{side}"],
+                                  top + np.outer(where, axis), axis)
             values.append(reduce(girths))
         return float(np.mean(values))
 
@@ -204,38 +208,25 @@ class Measurer:
         out["F"] = self._horizontal_girth(v, "trunk_thighs",
                                           buttocks[np.argmax(buttocks[:, 1]), 2])[0]
         out["G"] = self._limb_girths(v, "wrist", np.array([1.0]), np.nanmax)
-        out["H"] = self._upper_arm_girth(v, acromion)
+        # midway between acromion and elbow: where that point projects onto the axis
+        out["H"] = self._limb_girths(
+            v, "upperarm", lambda top, bottom, i: np.dot(0.5 * (acromion[i] + bottom) - top,
+                                                         bottom - top) / np.sum((bottom - top) ** 2),
+            np.nanmax)
         out["I"] = self._limb_girths(v, "forearm", np.linspace(0.1, 0.4, 7), np.nanmax)
         radiale, stylion = self._point(v, "radiale"), self._point(v, "stylion")
         out["J"] = float(np.mean(np.linalg.norm(acromion - radiale, axis=1)
                                  + np.linalg.norm(radiale - stylion, axis=1)))
         out["K"] = crotch[2] - floor
-        out["L"] = self._thigh_girth(v, crotch[2] - 0.02 * stature)
+        fold = crotch[2] - 0.02 * stature  # where each thigh's axis passes this height
+        out["L"] = self._limb_girths(v, "thigh",
+                                     lambda top, bottom, i: (top[2] - fold) / (top[2] - bottom[2]),
+                                     np.nanmax)
         out["M"] = self._limb_girths(v, "shank", np.linspace(0.2, 0.5, 7), np.nanmax)
         out["N"] = self._limb_girths(v, "shank", np.linspace(0.75, 0.92, 6), np.nanmin)
         out["O"] = stature
         out["P"] = float(np.linalg.norm(acromion[0] - acromion[1]))
         return {k: float(out[k]) * 1000.0 for k in MEASUREMENTS}
-
-    def _upper_arm_girth(self, v: np.ndarray, acromion: np.ndarray) -> float:
-        values = []
-        for i, side in enumerate(_SIDES):
-            shoulder = self._ring(v, "shoulder", side)
-            elbow = self._ring(v, "elbow", side)
-            origin = 0.5 * (acromion[i] + elbow)
-            values.append(tape_lengths(v, self._edges[f"upperarm.{side}"], [origin],
-                                       elbow - shoulder)[0])
-        return float(np.mean(values))
-
-    def _thigh_girth(self, v: np.ndarray, height: float) -> float:
-        """Girth perpendicular to each thigh where its axis passes ``height`` (metres)."""
-        values = []
-        for side in _SIDES:
-            hip, knee = self._ring(v, "hip", side), self._ring(v, "knee", side)
-            t = (hip[2] - height) / (hip[2] - knee[2])
-            values.append(tape_lengths(v, self._edges[f"thigh.{side}"],
-                                       [hip + t * (knee - hip)], knee - hip)[0])
-        return float(np.mean(values))
 
     def measure_many(self, vertices: np.ndarray) -> np.ndarray:
         """(N, 16) float64 measurements in mm, columns in ``MEASUREMENTS`` order, of

@@ -82,7 +82,9 @@ def principal_components(shapes: np.ndarray, count: int, chunk: int = 4096):
 
     Returns:
         mean: (D,) float64; components: (count, D) float32 orthonormal rows;
-        eigenvalues: (count,) float64, variance along each component (unbiased).
+        eigenvalues: (count,) float64, variance along each component (unbiased);
+        scores: (N, count) float64, each row's coefficients in units of standard
+        deviation (the Gram eigenvectors scaled by sqrt(N - 1)).
     """
     n, d = shapes.shape
     mean = shapes.mean(axis=0, dtype=np.float64)
@@ -98,7 +100,7 @@ def principal_components(shapes: np.ndarray, count: int, chunk: int = 4096):
         block = shapes[:, start:start + chunk] - mean[start:start + chunk]
         components[:, start:start + chunk] = eigvec.T @ block
     components /= np.sqrt(eigval)[:, None]
-    return mean, components.astype(np.float32), eigval / (n - 1)
+    return mean, components.astype(np.float32), eigval / (n - 1), eigvec * np.sqrt(n - 1)
 
 
 def build_model(settings: ModelBuildSettings = ModelBuildSettings()) -> BodyModel:
@@ -121,8 +123,7 @@ def build_model(settings: ModelBuildSettings = ModelBuildSettings()) -> BodyMode
     n, v = population.vertices.shape[:2]
     shapes = np.concatenate([population.vertices.reshape(n, -1),
                              population.joints.reshape(n, -1)], axis=1)
-    mean, components, eigenvalues = principal_components(shapes, settings.components)
-    betas = ((shapes - mean) @ components.T.astype(np.float64)) / np.sqrt(eigenvalues)
+    mean, components, eigenvalues, betas = principal_components(shapes, settings.components)
     t_pca = time.perf_counter()
 
     c = settings.components

@@ -122,7 +122,6 @@ class Population:
         vertices: (N, V, 3) float32, metres, rest A-pose.
         joints: (N, 4, 3) float32, metres, rig joints.
         measurements: (N, 16) float64 mm, ``MEASUREMENTS`` order.
-        targets: (N, len(TARGET_KEYS)) float64 mm, the measurements each body was fitted to.
     """
 
     sex: np.ndarray
@@ -130,7 +129,6 @@ class Population:
     vertices: np.ndarray
     joints: np.ndarray
     measurements: np.ndarray
-    targets: np.ndarray
 
 
 class PopulationSampler:
@@ -222,7 +220,7 @@ class PopulationSampler:
                                           (hi - params[b]) / scale)).x
                 params[b] = np.clip(params[b] + step * scale, lo, hi)
         _, params, vertices, joints, meas = best
-        return Population(np.full(n, sex), params, vertices, joints, meas, targets)
+        return Population(np.full(n, sex), params, vertices, joints, meas)
 
     @staticmethod
     def _broyden(jacobians: np.ndarray, dx: np.ndarray, dm: np.ndarray) -> None:

@@ -45,7 +45,8 @@ def realism_section(model: BodyModel) -> list[str]:
     lines = ["## The population next to ANSUR II", "",
              f"The {len(model.population_sex)} bodies the shape space was learned from "
              "(half men, half women), measured with bodyfit's definitions "
-             "(`bodyfit.fitter.measurements`), against ANSUR II (4,082 men, 1,986 women). "
+             f"(`bodyfit.fitter.measurements`), against ANSUR II ({ref.n['male']:,} men, "
+             f"{ref.n['female']:,} women). "
              "Mean (SD) in mm; ratio = population / ANSUR. The issue's bar: ratios within "
              "0.90-1.10 for the measurements marked *.", ""]
     for sex in SEXES:

@@ -100,3 +100,20 @@ def test_corrupt_cache_is_rebuilt(tmp_path, monkeypatch, body_model):
     assert model_cache.load_model() is body_model and built == [1]
     with pytest.raises(UserError):
         model_cache.load_model(build_if_needed=False)
+
+
+def test_principal_components_match_numpy_svd():
+    from bodyfit.fitter.model_build import principal_components
+
+    rng = np.random.default_rng(5)
+    data = (rng.standard_normal((120, 120)) * np.exp(-np.arange(120) / 8.0)) @ \
+        rng.standard_normal((120, 900))
+    data = data.astype(np.float32)
+    mean, comps, eigvals, scores = principal_components(data, 10, chunk=256)
+    centred = data.astype(np.float64) - data.mean(axis=0, dtype=np.float64)
+    _, sing, vt = np.linalg.svd(centred, full_matrices=False)
+    np.testing.assert_allclose(mean, data.mean(axis=0, dtype=np.float64), atol=1e-9)
+    np.testing.assert_allclose(eigvals, sing[:10] ** 2 / 119, rtol=1e-6)
+    np.testing.assert_allclose(np.abs(np.sum(comps * vt[:10], axis=1)), 1.0, atol=1e-5)
+    np.testing.assert_allclose(scores, centred @ comps.T.astype(np.float64) / np.sqrt(eigvals),
+                               atol=1e-4)
