@@ -1,8 +1,12 @@
 """Atomic output files: a reader never sees a half-written result.
 
-Every output of the `calib` commands goes through :func:`write_atomic`: the bytes are
-written to a temporary file in the destination folder and renamed over the
+Every output of the `calib` and `fitter` commands goes through :func:`write_atomic`: the
+bytes are written to a temporary file in the destination folder and renamed over the
 destination, so a crash or an error leaves either the old file or the new one.
+
+Output folders follow one rule for every command: a folder that does not exist yet is
+created (with its missing parents) when the first file is written into it, and a write
+that fails removes the folders it created, so a failed command leaves nothing behind.
 """
 
 from __future__ import annotations
@@ -16,37 +20,62 @@ from bodyfit.calib.errors import UserError
 __all__ = ["check_writable_dir", "write_atomic"]
 
 
+def _nearest_existing(path: Path) -> Path:
+    while not path.exists() and path != path.parent:
+        path = path.parent
+    return path
+
+
 def check_writable_dir(directory: str | os.PathLike) -> Path:
     """Return ``directory`` as a Path, or raise UserError if outputs cannot go there.
 
-    Called before any work starts, so that a long calibration does not end in a
-    failed write.
+    The folder may not exist yet: then its nearest existing parent must be a writable
+    folder (the folder is created by the first :func:`write_atomic` into it). Called
+    before any work starts, so that a long calibration does not end in a failed write.
     """
     path = Path(directory) if str(directory) else Path(".")
-    if not path.is_dir():
-        raise UserError(f"output folder {str(path)!r} does not exist; create it first")
-    if not os.access(path, os.W_OK):
+    existing = _nearest_existing(path)
+    if not existing.is_dir():
+        raise UserError(f"output folder {str(path)!r} cannot be created: {str(existing)!r} is a file")
+    if not os.access(existing, os.W_OK):
         raise UserError(f"output folder {str(path)!r} is not writable")
     return path
+
+
+def _make_folders(folder: Path) -> list[Path]:
+    """Create ``folder`` and its missing parents; return those created, deepest first."""
+    missing = []
+    while not folder.exists():
+        missing.append(folder)
+        folder = folder.parent
+    for created in reversed(missing):
+        created.mkdir()
+    return missing
 
 
 def write_atomic(path: str | os.PathLike, payload: bytes) -> None:
     """Write ``payload`` to ``path`` through a temporary file and a rename.
 
-    Raises UserError when the folder is missing or not writable, or the write fails
-    (disk full); no temporary file is left behind on failure.
+    Creates the destination folder if needed. Raises UserError when the folder cannot be
+    created or written, or the write fails (disk full); nothing is left behind on failure:
+    no temporary file, and no folder this call created.
     """
     target = Path(path)
     folder = check_writable_dir(target.parent)
     # open(..., "xb") rather than mkstemp: the file gets the umask's permissions, not 0600.
     temp_name = folder / f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
+    created: list[Path] = []
     try:
+        created = _make_folders(folder)
         with open(temp_name, "xb") as stream:
             stream.write(payload)
             stream.flush()
             os.fsync(stream.fileno())
         os.replace(temp_name, target)
+        created = []
     except OSError as error:
         raise UserError(f"cannot write {target}: {error.strerror or error}") from None
     finally:
         temp_name.unlink(missing_ok=True)  # gone already after a successful rename
+        for folder_made in created:
+            folder_made.rmdir()

@@ -88,8 +88,23 @@ def test_write_atomic_replaces_whole_files_and_leaves_no_temporaries(tmp_path):
     write_atomic(target, b"second")
     assert target.read_bytes() == b"second"
     assert [p.name for p in tmp_path.iterdir()] == ["out.bin"]
-    with pytest.raises(UserError, match="does not exist"):
-        write_atomic(tmp_path / "missing" / "out.bin", b"x")
+
+
+def test_write_atomic_creates_missing_folders(tmp_path):
+    write_atomic(tmp_path / "a" / "b" / "out.bin", b"x")
+    assert (tmp_path / "a" / "b" / "out.bin").read_bytes() == b"x"
+
+
+def test_write_atomic_failure_removes_the_folders_it_created(tmp_path):
+    (tmp_path / "file").write_bytes(b"")
+    with pytest.raises(UserError, match="is a file"):
+        write_atomic(tmp_path / "file" / "sub" / "out.bin", b"x")
+    with pytest.raises(UserError, match="cannot write"):  # the target is a folder
+        (tmp_path / "new" / "taken").mkdir(parents=True)
+        write_atomic(tmp_path / "new" / "taken", b"x")
+    with pytest.raises(UserError, match="cannot write"):  # a name longer than any allowed
+        write_atomic(tmp_path / "made" / "deeper" / ("x" * 300), b"x")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file", "new"]
 
 
 def test_write_image_refuses_unknown_formats(tmp_path):
