@@ -127,9 +127,8 @@ class BodyModel:
 
     # ----------------------------------------------------------------- file I/O
     def save(self, path: Path) -> None:
-        """Write an uncompressed .npz atomically (a temporary file, then a rename)."""
+        """Write a compressed .npz atomically (a temporary file, then a rename)."""
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
         arrays = {
             f.name: getattr(self, f.name)
             for f in dataclasses.fields(self)
@@ -139,7 +138,7 @@ class BodyModel:
         meta = dict(self.metadata, format_version=FORMAT_VERSION)
         arrays["metadata_json"] = np.array(json.dumps(meta))
         buffer = io.BytesIO()
-        np.savez(buffer, **arrays)
+        np.savez_compressed(buffer, **arrays)
         write_atomic(path, buffer.getvalue())
 
     @classmethod
@@ -156,8 +155,11 @@ class BodyModel:
                 files = dict(npz.items())
         except FileNotFoundError:
             raise UserError(f"no body model at {path}; run `fitter model build`") from None
-        except Exception as exc:  # zip, pickle and value errors: all mean "corrupt"
-            raise UserError(f"body model file {path} is corrupt ({exc}); "
+        except IsADirectoryError:
+            raise UserError(f"body model path {path} is a folder, not a model file") from None
+        except Exception:  # zip, pickle and value errors: all mean "corrupt". numpy's own
+            # message may advise allow_pickle=True, which must never be followed here.
+            raise UserError(f"body model file {path} is corrupt (not a model .npz); "
                             "run `fitter model build` to rebuild it") from None
         try:
             meta = json.loads(str(files.pop("metadata_json")))

@@ -1,11 +1,14 @@
-"""`fitter`: the body model, measurements and (later) fitting, from the command line.
+"""`fitter`: the body model and its 16 measurements from the command line.
 
-User errors print one line, ``fitter: error: ...``, and exit with status 2.
+Fitting the model to a person's photos (`fitter run`) is not available yet; the help
+says only what exists. User errors, usage errors included, print one line,
+``fitter: error: ...``, and exit with status 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
 import logging
 import sys
 import time
@@ -18,24 +21,44 @@ __all__ = ["main"]
 logger = logging.getLogger("bodyfit")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports usage errors in one line, like every other fitter error."""
+
+    def error(self, message: str) -> None:  # noqa: D102 - argparse's hook
+        self.exit(2, f"fitter: error: {message} (see `{self.prog} --help`)\n")
+
+
+def _version() -> str:
+    try:
+        return importlib.metadata.version("bodyfit")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
 def _build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="fitter",
-        description="bodyfit: 3D body and 16 tape measurements (millimetres) from photos. "
-                    "Lengths in files are metres (meshes) and millimetres (measurements).")
+        description="bodyfit's statistical body model and its 16 tape measurements: draw "
+                    "bodies, measure meshes, build the model. Lengths in files are metres "
+                    "(meshes) and millimetres (measurements).")
+    parser.add_argument("--version", action="version", version=f"bodyfit {_version()}")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     model = sub.add_parser("model", help="build or inspect the body model")
     model_sub = model.add_subparsers(dest="model_command", required=True, metavar="ACTION")
     build = model_sub.add_parser(
-        "build", help="build the body model from Anny into the cache (a few minutes)")
+        "build", help="build the body model from Anny into the cache (about 4 minutes; "
+                      "bodyfit ships a default model, so this is for other settings)")
     build.add_argument("--components", type=int, default=60,
                        help="PCA shape components to store (default 60; fitting uses 20)")
     build.add_argument("--samples", type=int, default=3000,
                        help="bodies in the population, half men, half women (default 3000)")
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    model_sub.add_parser("info", help="print where the model is and how it was built")
+    build.add_argument("-o", "--output", type=Path,
+                       help="write the model here instead of the cache (.npz); "
+                            "fitter/data/body_model.npz is the model bodyfit ships")
+    model_sub.add_parser("info", help="print which model is used and how it was built")
 
     demo = sub.add_parser("demo", help="built-in example: draw bodies, write meshes "
                                        "(.obj/.ply, metres), measurements (mm) and a picture")
@@ -55,27 +78,37 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_model_build(args) -> None:
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    from bodyfit.calib.files import check_writable_dir
     from bodyfit.fitter.model_build import ModelBuildSettings
     from bodyfit.fitter.model_cache import build_and_save, model_path
 
     settings = ModelBuildSettings(components=args.components, samples=args.samples,
                                   seed=args.seed)
     settings.validate()
-    model = build_and_save(settings)
+    path = args.output or model_path()
+    if path.suffix != ".npz":
+        raise UserError(f"-o takes a .npz path, got {path}")
+    check_writable_dir(path.parent)
+    with logging_redirect_tqdm():
+        model = build_and_save(settings, path, progress=None if not args.quiet else False)
     t = model.metadata["timings_s"]
     print(f"built the body model in {t['total']:.0f} s: {model.num_vertices} vertices, "
           f"{model.num_components} components, {len(model.population_sex)} bodies")
-    print(f"wrote {model_path()}")
+    print(f"wrote {path}")
 
 
 def _cmd_model_info(args) -> None:
-    from bodyfit.fitter.model_cache import load_model, model_path
+    from bodyfit.fitter.model_cache import active_model_path, load_model, model_path
 
     t0 = time.perf_counter()
-    model = load_model(build_if_needed=False)
+    model = load_model()
     load_s = time.perf_counter() - t0
     meta = model.metadata
-    print(f"body model: {model_path()} ({model_path().stat().st_size / 1e6:.1f} MB, "
+    path = active_model_path()
+    origin = "built by you" if path == model_path() else "shipped with bodyfit"
+    print(f"body model ({origin}): {path} ({path.stat().st_size / 1e6:.1f} MB, "
           f"loaded in {load_s * 1000:.0f} ms)")
     print(f"  {model.num_vertices} vertices, {len(model.faces)} faces, "
           f"{model.num_components} components ({meta['explained_variance']:.6f} of the "
@@ -118,7 +151,10 @@ def _cmd_measure(args) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = _build_parser().parse_args(argv)
+    try:
+        args = _build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help, --version, usage errors: argparse has printed
+        return int(stop.code or 0)
     logging.basicConfig(level=logging.ERROR if args.quiet else logging.INFO,
                         format="%(message)s")
     logging.getLogger("anny").setLevel(logging.WARNING)

@@ -17,7 +17,7 @@ from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.mesh_io import write_mesh
 from bodyfit.calib.images import write_image
 from bodyfit.fitter.outputs import staged_directory, write_measurements
-from bodyfit.fitter.render import parts_legend, render_parts
+from bodyfit.fitter.render import labelled_grid, parts_legend, render_parts
 
 __all__ = ["DemoSettings", "run_demo"]
 
@@ -33,7 +33,8 @@ class DemoSettings:
 
 def run_demo(model: BodyModel, out_dir: Path, settings: DemoSettings = DemoSettings()) -> list[Path]:
     """Write ``body_<i>.obj``/``.ply`` (rest A-pose, metres), ``measurements.json``/``.csv``
-    (mm) and ``bodies.png`` into ``out_dir``; return the paths written."""
+    (mm) and ``bodies.png`` (a grid of front and side views, each labelled with its mesh
+    file's name) into ``out_dir``; return the paths written."""
     rng = np.random.default_rng(settings.seed)
     n = settings.bodies
     betas = np.clip(rng.standard_normal((n, settings.num_betas)),
@@ -42,9 +43,11 @@ def run_demo(model: BodyModel, out_dir: Path, settings: DemoSettings = DemoSetti
     measurer = Measurer.from_model(model)
     names = [f"body_{i}" for i in range(n)]
     face_parts = model.face_parts
-    views = [render_parts(v, model.faces, face_parts, view, settings.picture_height_px)
-             for v in rest for view in ("front", "side")]
-    picture = np.concatenate(views + [parts_legend(settings.picture_height_px)], axis=1)
+    tiles = [np.concatenate([render_parts(v, model.faces, face_parts, view,
+                                          settings.picture_height_px)
+                             for view in ("front", "side")], axis=1) for v in rest]
+    picture = labelled_grid(tiles, [f"{name}.obj (front, side)" for name in names],
+                            parts_legend(settings.picture_height_px))
     written = []
     with staged_directory(out_dir) as stage:
         for name, vertices in zip(names, rest):

@@ -67,7 +67,7 @@ def read_mesh(path: Path, faces: np.ndarray, units: str = "m") -> np.ndarray:
             f"{path} is a mesh of another topology ({len(mesh.vertices)} vertices, "
             f"{len(mesh.faces)} faces); bodyfit measures meshes in its body model's "
             f"topology ({faces.max() + 1} vertices, {len(faces)} faces), such as the "
-            "mesh.obj that `fitter run` or `fitter demo` writes")
+            "body_<i>.obj files that `fitter demo` writes")
     vertices = mesh.vertices * UNITS_TO_METRES[units]
     height = np.ptp(vertices[:, 2])
     lo, hi = _PLAUSIBLE_HEIGHT_M

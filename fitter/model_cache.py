@@ -1,24 +1,31 @@
-"""Where the built body model lives, and loading it (building it on first use).
+"""Where the body model comes from: the user's own build, else the one shipped with bodyfit.
 
-The model is cached in ``$BODYFIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/bodyfit``,
-else ``~/.cache/bodyfit``, as ``body_model.npz``. Anny keeps its own data cache
-(``$ANNY_CACHE_DIR`` or ``~/.cache/anny``), which a first build fills.
+bodyfit ships its default body model inside the package (``bodyfit/fitter/data/
+body_model.npz``, compressed, built by ``fitter model build --output
+fitter/data/body_model.npz`` with the default settings; its metadata records those
+settings and the Anny version). ``fitter model build`` writes a user-built model to the
+cache, ``$BODYFIT_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/bodyfit``, else
+``~/.cache/bodyfit``, as ``body_model.npz``; when that file exists it is used instead of
+the shipped one. A corrupt or outdated cached model is an error (never silently rebuilt
+or bypassed): the message says to rebuild it or to delete it. Anny keeps its own data
+cache (``$ANNY_CACHE_DIR`` or ``~/.cache/anny``, about 1.1 GB), which only a build fills.
 """
 
 from __future__ import annotations
 
-import logging
 import os
+from importlib import resources
 from pathlib import Path
 
 from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import BodyModel
 
-__all__ = ["CACHE_ENV_VAR", "cache_dir", "model_path", "load_model", "build_and_save"]
-
-logger = logging.getLogger(__name__)
+__all__ = ["CACHE_ENV_VAR", "SHIPPED_MODEL", "cache_dir", "model_path", "active_model_path",
+           "load_model", "build_and_save"]
 
 CACHE_ENV_VAR = "BODYFIT_CACHE_DIR"
+#: The default model's file name inside the package ``bodyfit.fitter.data``.
+SHIPPED_MODEL = "body_model.npz"
 
 
 def cache_dir() -> Path:
@@ -30,31 +37,42 @@ def cache_dir() -> Path:
 
 
 def model_path() -> Path:
+    """Where ``fitter model build`` writes a user-built model (it may not exist)."""
     return cache_dir() / "body_model.npz"
 
 
-def build_and_save(settings=None) -> BodyModel:
-    """Build the model (see :mod:`bodyfit.fitter.model_build`) and write it to the cache."""
+def shipped_model_path() -> Path:
+    return Path(str(resources.files("bodyfit.fitter.data").joinpath(SHIPPED_MODEL)))
+
+
+def active_model_path() -> Path:
+    """The model file :func:`load_model` reads: the user-built one if any, else the shipped."""
+    return model_path() if model_path().exists() else shipped_model_path()
+
+
+def build_and_save(settings=None, path: Path | None = None,
+                   progress: bool | None = None) -> BodyModel:
+    """Build the model (see :mod:`bodyfit.fitter.model_build`) and write it to ``path``
+    (default: the cache); ``progress`` as in :func:`~bodyfit.fitter.model_build.build_model`."""
     from bodyfit.fitter.model_build import ModelBuildSettings, build_model
 
-    model = build_model(settings or ModelBuildSettings())
-    model.save(model_path())
-    logger.info("wrote %s", model_path())
+    path = Path(path) if path is not None else model_path()
+    model = build_model(settings or ModelBuildSettings(), progress=progress)
+    model.save(path)
     return model
 
 
-def load_model(build_if_needed: bool = True) -> BodyModel:
-    """The cached model; a missing, corrupt or outdated cache is rebuilt with the
-    default settings (a few minutes), or raises UserError if ``build_if_needed`` is False."""
-    path = model_path()
-    try:
-        return BodyModel.load(path)
-    except UserError as exc:
-        if not build_if_needed:
-            raise
-        if path.exists():
-            logger.warning("the cached body model is unusable (%s); rebuilding it", exc)
-        else:
-            logger.warning("no body model cached at %s yet; building it (a few minutes, "
-                           "once)", path)
-    return build_and_save()
+def load_model() -> BodyModel:
+    """The user-built model in the cache if there is one, else the model shipped with
+    bodyfit. Raises UserError if the chosen file is unusable."""
+    path = active_model_path()
+    if path == model_path():
+        try:
+            return BodyModel.load(path)
+        except UserError as exc:
+            raise UserError(f"{exc} (or delete {path} to use the model shipped with "
+                            "bodyfit)") from None
+    if not path.exists():
+        raise UserError(f"this bodyfit install lacks its body model ({path}); reinstall "
+                        "bodyfit or run `fitter model build`")
+    return BodyModel.load(path)

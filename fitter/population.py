@@ -151,10 +151,13 @@ class PopulationSampler:
         noise = rng.standard_normal((n, len(centre))) * self._start_spread * widen
         return np.clip(centre + noise, lo, hi)
 
-    def _bodies(self, sex: str, params: np.ndarray):
+    def _bodies(self, sex: str, params: np.ndarray, progress=None):
         gender = np.full(len(params), _GENDER[sex])
         vertices, joints = self.source.rest_bodies(gender, params)
-        return vertices, joints, self.measurer.measure_many(vertices)
+        measured = self.measurer.measure_many(vertices)
+        if progress is not None:
+            progress.update(len(params))
+        return vertices, joints, measured
 
     @staticmethod
     def _regress(params: np.ndarray, measured: np.ndarray) -> np.ndarray:
@@ -164,21 +167,32 @@ class PopulationSampler:
         coef, *_ = np.linalg.lstsq(design, measured[keep], rcond=None)
         return coef[1:].T
 
-    def sample(self, counts: dict[str, int], seed: int) -> Population:
-        """Draw ``counts[sex]`` bodies of each sex, reproducibly from ``seed``."""
+    def work_units(self, counts: dict[str, int]) -> int:
+        """How many units :meth:`sample` reports to its ``progress``: one per body built
+        and measured and one per fitting step solved."""
+        iterations = self.settings.iterations
+        return sum(self.settings.pool_per_sex + (2 * iterations + 1) * n
+                   for n in counts.values() if n > 0)
+
+    def sample(self, counts: dict[str, int], seed: int, progress=None) -> Population:
+        """Draw ``counts[sex]`` bodies of each sex, reproducibly from ``seed``.
+
+        ``progress``, if given, is told of the work done by ``progress.update(units)``
+        (a tqdm bar; :meth:`work_units` units in all)."""
         parts = []
         for i, sex in enumerate(SEXES):
             if counts.get(sex, 0) > 0:
                 rng = np.random.default_rng([seed, i])
-                parts.append(self._sample_sex(sex, counts[sex], rng))
+                parts.append(self._sample_sex(sex, counts[sex], rng, progress))
         return Population(*(np.concatenate([getattr(p, f.name) for p in parts])
                             for f in dataclasses.fields(Population)))
 
-    def _sample_sex(self, sex: str, n: int, rng: np.random.Generator) -> Population:
+    def _sample_sex(self, sex: str, n: int, rng: np.random.Generator,
+                    progress=None) -> Population:
         # One linear map from a pool spread wider than the start distribution, then
         # refined per body by Broyden's rank-one updates along the steps it takes.
         pool = self._start(self.settings.pool_per_sex, rng, widen=2.0)
-        jac = self._regress(pool, self._bodies(sex, pool)[2][:, self._target_cols])
+        jac = self._regress(pool, self._bodies(sex, pool, progress)[2][:, self._target_cols])
         jacobians = np.repeat(jac[None], n, axis=0)  # (n, k, D) mm per parameter unit
         targets = self.stats.sample(sex, n, rng)
         start = self._start(n, rng)
@@ -189,7 +203,7 @@ class PopulationSampler:
         previous = None
         best = None  # per body, the evaluated parameters with the lowest objective so far
         for it in range(self.settings.iterations + 1):
-            vertices, joints, meas = self._bodies(sex, params)
+            vertices, joints, meas = self._bodies(sex, params, progress)
             measured = meas[:, self._target_cols]
             residual = targets - measured
             objective = (np.sum(np.nan_to_num(row_scale * residual, nan=1e6) ** 2, axis=1)
@@ -200,9 +214,11 @@ class PopulationSampler:
                 better = objective < best[0]
                 for store, new in zip(best, (objective, params, vertices, joints, meas)):
                     store[better] = new[better]
-            logger.info("%s iteration %d: mean |miss| %s mm", sex, it,
-                        np.round(np.nanmean(np.abs(targets - best[4][:, self._target_cols]),
-                                            axis=0), 1))
+            miss = np.nanmean(np.abs(targets - best[4][:, self._target_cols]), axis=0)
+            logger.info("%s bodies, step %d of %d: mean miss of the ANSUR targets (mm): %s",
+                        sex, it, self.settings.iterations,
+                        ", ".join(f"{MEASUREMENTS[k][0].removesuffix('_circumference')} {m:.1f}"
+                                  for k, m in zip(TARGET_KEYS, miss)))
             if it == self.settings.iterations:
                 break
             if previous is not None:
@@ -219,6 +235,8 @@ class PopulationSampler:
                                   bounds=((lo - params[b]) / scale,
                                           (hi - params[b]) / scale)).x
                 params[b] = np.clip(params[b] + step * scale, lo, hi)
+                if progress is not None:
+                    progress.update(1)
         _, params, vertices, joints, meas = best
         return Population(np.full(n, sex), params, vertices, joints, meas)
 

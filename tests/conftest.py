@@ -1,14 +1,16 @@
-"""Shared fixtures: the body model (built into the cache on first use) and Anny."""
+"""Shared fixtures: the body model shipped with bodyfit, and Anny."""
 
 import pytest
 
 
 @pytest.fixture(scope="session")
 def body_model():
-    """The cached default body model; the first run builds it (a few minutes)."""
-    from bodyfit.fitter.model_cache import load_model
+    """The default body model shipped in the package (a user-built model in the cache,
+    if any, is not used, so the tests see what every install sees)."""
+    from bodyfit.fitter.body_model import BodyModel
+    from bodyfit.fitter.model_cache import shipped_model_path
 
-    return load_model()
+    return BodyModel.load(shipped_model_path())
 
 
 @pytest.fixture(scope="session")

@@ -26,7 +26,7 @@ import numpy as np
 from bodyfit.fitter.anny_source import AnnySource
 from bodyfit.fitter.body_model import BodyModel, project_shape, rest_shape
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS, Measurer
-from bodyfit.fitter.model_cache import load_model, model_path
+from bodyfit.fitter.model_cache import active_model_path, load_model
 from bodyfit.calib.images import write_image
 from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.model_build import ModelBuildSettings
@@ -117,7 +117,7 @@ def main() -> None:
     args = parser.parse_args()
 
     model = load_model()
-    path = model_path()
+    path = active_model_path()
     loads = []
     for _ in range(5):
         t0 = time.perf_counter()
@@ -147,7 +147,7 @@ def main() -> None:
              f"(setup {meta['timings_s']['setup']:.0f} s, population "
              f"{meta['timings_s']['population']:.0f} s, PCA {meta['timings_s']['pca']:.0f} s), "
              "plus about a minute the first time Anny builds its own data cache",
-             f"- file: `{path.name}`, {path.stat().st_size / 1e6:.1f} MB (uncompressed .npz)",
+             f"- file: `{path.name}`, {path.stat().st_size / 1e6:.1f} MB (compressed .npz)",
              f"- load time: {np.median(loads) * 1000:.0f} ms (median of 5)",
              f"- held-out bodies for the table below: {args.held_out}, drawn in "
              f"{held_out_s:.0f} s", "",

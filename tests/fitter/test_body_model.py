@@ -91,15 +91,59 @@ def test_incomplete_model_file_is_one_clear_error(body_model, tmp_path):
         BodyModel.load(path)
 
 
-def test_corrupt_cache_is_rebuilt(tmp_path, monkeypatch, body_model):
+def test_shipped_model_is_used_without_a_user_build(tmp_path, monkeypatch, body_model):
+    monkeypatch.setenv(model_cache.CACHE_ENV_VAR, str(tmp_path))
+    assert model_cache.active_model_path() == model_cache.shipped_model_path()
+    loaded = model_cache.load_model()
+    np.testing.assert_array_equal(loaded.vertex_components, body_model.vertex_components)
+    assert not list(tmp_path.iterdir())  # nothing built, nothing written
+
+
+def test_shipped_model_records_how_it_was_built(body_model):
+    """The shipped model is the default build: `fitter model build -o
+    fitter/data/body_model.npz` with the default settings, Anny's version recorded."""
+    import dataclasses
+
+    assert body_model.metadata["settings"] == dataclasses.asdict(ModelBuildSettings())
+    assert re.fullmatch(r"\d+\.\d+.*", body_model.metadata["anny_version"])
+
+
+def test_corrupt_user_model_is_an_error_not_a_rebuild(tmp_path, monkeypatch):
     monkeypatch.setenv(model_cache.CACHE_ENV_VAR, str(tmp_path))
     model_cache.model_path().write_bytes(b"garbage")
-    built = []
-    monkeypatch.setattr(model_cache, "build_and_save",
-                        lambda settings=None: built.append(1) or body_model)
-    assert model_cache.load_model() is body_model and built == [1]
-    with pytest.raises(UserError):
-        model_cache.load_model(build_if_needed=False)
+    with pytest.raises(UserError, match="corrupt.*delete") as error:
+        model_cache.load_model()
+    assert "allow_pickle" not in str(error.value)
+    assert model_cache.model_path().read_bytes() == b"garbage"
+
+
+def test_pickled_file_error_gives_no_pickle_advice(tmp_path):
+    import pickle
+
+    path = tmp_path / "model.npz"
+    path.write_bytes(pickle.dumps({"a": 1}))
+    with pytest.raises(UserError, match="corrupt") as error:
+        BodyModel.load(path)
+    assert "allow_pickle" not in str(error.value)
+
+
+def test_small_build_saves_and_loads(tmp_path, monkeypatch):
+    """The build end to end on a small population (the full one takes minutes): the
+    user-built model in the cache then takes the shipped one's place."""
+    from bodyfit.fitter.population import PopulationSettings
+
+    monkeypatch.setenv(model_cache.CACHE_ENV_VAR, str(tmp_path))
+    settings = ModelBuildSettings(components=6, samples=100, seed=3,
+                                  population=PopulationSettings(iterations=1, pool_per_sex=60))
+    built = model_cache.build_and_save(settings, progress=False)
+    assert model_cache.active_model_path() == model_cache.model_path()
+    loaded = model_cache.load_model()
+    assert loaded.num_components == 6 and len(loaded.population_sex) == 100
+    assert ModelBuildSettings.of(loaded) == settings
+    np.testing.assert_array_equal(loaded.vertex_components, built.vertex_components)
+    # the population is centred and whitened by the PCA: betas have mean 0, variance 1
+    np.testing.assert_allclose(loaded.population_betas.mean(axis=0), 0, atol=1e-3)
+    np.testing.assert_allclose(loaded.population_betas.var(axis=0, ddof=1), 1, atol=1e-3)
 
 
 def test_principal_components_match_numpy_svd():
