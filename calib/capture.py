@@ -22,12 +22,13 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from tqdm import tqdm
 
 from bodyfit.calib.blur import edge_rise_px
 from bodyfit.calib.boards import BoardDetection, BoardDetector, BoardSpec
 from bodyfit.calib.camera import Camera, camera_fields
 from bodyfit.calib.errors import UserError
-from bodyfit.calib.images import frame_name, read_frames
+from bodyfit.calib.images import frame_name, is_video, read_frames
 
 __all__ = [
     "DISTORTION_MODELS",
@@ -166,15 +167,20 @@ def _moved_px(a: BoardDetection, b: BoardDetection) -> float:
 def collect_views(
     paths: Iterable[str], detector: BoardDetector, settings: CaptureSettings
 ) -> tuple[list[View], tuple[int, int]]:
-    """Find the board in every input image and sort out the views to use.
+    """Find the board in every input image and sort out the views to use (with a
+    progress bar on stderr when it is a terminal).
 
     Returns:
         (views, image_size_px): every view with its status (``used`` ones still face
         outlier rejection in :func:`calibrate`), and (width, height) of the images.
     """
+    paths = list(paths)
     views: list[View] = []
     image_size: tuple[int, int] | None = None
-    for source, frame_index, image in read_frames(paths, settings.video_max_frames):
+    frames = tqdm(read_frames(paths, settings.video_max_frames), desc="finding the board",
+                  unit="view", disable=None, leave=False,
+                  total=sum(settings.video_max_frames if is_video(p) else 1 for p in paths))
+    for source, frame_index, image in frames:
         image_size = (image.shape[1], image.shape[0])
         gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
         detection = detector.detect(gray)
