@@ -136,8 +136,10 @@ def main() -> None:
     lines = ["# The body model", "",
              f"Produced by `{command.strip()}` on {time.strftime('%Y-%m-%d')} "
              f"({platform.machine()}, {platform.python_version()}, "
-             f"anny {meta['anny_version']}). The model is built by `fitter model build` "
-             "(see `fitter/model_build.py`); this file by `tools/model_report.py`.", "",
+             f"anny {meta['anny_version']}). The model described is the one `fitter` uses "
+             "(`fitter model info` names it); the shipped default is built by `fitter model build -o "
+             "fitter/data/body_model.npz` (see `fitter/model_build.py`); this file by "
+             "`tools/model_report.py`.", "",
              "## Build", "",
              f"- settings: {meta['settings']}",
              f"- {model.num_vertices} vertices, {len(model.faces)} triangles, "
@@ -146,7 +148,7 @@ def main() -> None:
              f"- build time: {meta['timings_s']['total']:.0f} s on the build machine "
              f"(setup {meta['timings_s']['setup']:.0f} s, population "
              f"{meta['timings_s']['population']:.0f} s, PCA {meta['timings_s']['pca']:.0f} s), "
-             "plus about a minute the first time Anny builds its own data cache",
+             "plus about a minute the first time Anny builds its own data cache (1.1 GB)",
              f"- file: `{path.name}`, {path.stat().st_size / 1e6:.1f} MB (compressed .npz)",
              f"- load time: {np.median(loads) * 1000:.0f} ms (median of 5)",
              f"- held-out bodies for the table below: {args.held_out}, drawn in "
