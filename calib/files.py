@@ -65,17 +65,21 @@ def write_atomic(path: str | os.PathLike, payload: bytes) -> None:
     # open(..., "xb") rather than mkstemp: the file gets the umask's permissions, not 0600.
     temp_name = folder / f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
     created: list[Path] = []
+    temp_made = False
     try:
         created = _make_folders(folder)
         with open(temp_name, "xb") as stream:
+            temp_made = True
             stream.write(payload)
             stream.flush()
             os.fsync(stream.fileno())
         os.replace(temp_name, target)
+        temp_made = False
         created = []
     except OSError as error:
         raise UserError(f"cannot write {target}: {error.strerror or error}") from None
     finally:
-        temp_name.unlink(missing_ok=True)  # gone already after a successful rename
+        if temp_made:  # only when open() succeeded: a name too long cannot even be unlinked
+            temp_name.unlink(missing_ok=True)
         for folder_made in created:
             folder_made.rmdir()
