@@ -1,5 +1,6 @@
 """The `calib` command: what it writes, what it prints, and one-line errors for bad input."""
 
+import hashlib
 import json
 
 import cv2
@@ -47,6 +48,7 @@ def test_capture_writes_camera_json_with_its_provenance(calibrated):
     assert 0 < record["coverage_fraction"] <= 1
     provenance = record["provenance"]
     assert provenance["argv"][:2] == ["calib", "capture"] and provenance["inputs"] == inputs
+    assert provenance["input_sha256"] == [hashlib.sha256(open(p, "rb").read()).hexdigest() for p in inputs]
     assert provenance["bodyfit_version"] and provenance["time"].endswith("+00:00")
     assert load_camera(output).board == parse_board("chessboard:9x6", 25)
     coverage = cv2.imread(str(output.with_name("camera_coverage.png")))
@@ -84,6 +86,41 @@ def test_check_reports_the_error_on_held_out_photos(calibrated, chessboard_shots
     rms = float(held_out_line.split()[4])
     assert 0 < rms < 0.2
     assert f"over {len(held_out)} of {len(held_out)} views" in held_out_line
+    assert "calibrated on" not in result.stdout
+
+
+def test_check_reports_calibration_photos_apart_from_held_out_ones(calibrated, chessboard_shots, tmp_path, run_calib):
+    output, _ = calibrated
+    renamed = tmp_path / "renamed.png"  # a calibration photo under another name: same bytes
+    renamed.write_bytes(chessboard_shots.sharp[0].read_bytes())
+    result = run_calib("check", output, renamed, chessboard_shots.sharp[1], chessboard_shots.sharp[10])
+    assert result.code == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert f"  {renamed}: error" in result.stdout and lines[0].endswith(", calibrated on it")
+    assert lines[1].endswith(", calibrated on it") and not lines[2].endswith("calibrated on it")
+    assert any(line.startswith("held-out RMS reprojection error") and "over 1 of 1 views" in line for line in lines)
+    seen = next(line for line in lines if line.startswith("RMS reprojection error on 2 photos"))
+    assert "the camera was calibrated on (not held out): " in seen and "over 2 of 2 views" in seen
+
+    result = run_calib("check", output, chessboard_shots.sharp[2])
+    assert result.code == 0, result.stderr
+    assert "held-out" not in result.stdout
+    assert "RMS reprojection error on 1 photo the camera was calibrated on (not held out)" in result.stdout
+
+
+def test_check_recognises_calibration_photos_by_path_in_files_without_hashes(
+    calibrated, chessboard_shots, tmp_path, run_calib, monkeypatch
+):
+    output, _ = calibrated
+    record = json.loads(output.read_text())
+    del record["provenance"]["input_sha256"]  # as camera files written before hashes were
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(record))
+    monkeypatch.chdir(chessboard_shots.sharp[0].parent)
+    result = run_calib("check", old, chessboard_shots.sharp[0].name, chessboard_shots.sharp[10].name)
+    assert result.code == 0, result.stderr
+    assert "held-out RMS reprojection error" in result.stdout
+    assert "RMS reprojection error on 1 photo the camera was calibrated on (not held out)" in result.stdout
 
 
 def test_undistort_writes_the_kornia_result(calibrated, chessboard_shots, tmp_path, run_calib):
