@@ -52,7 +52,8 @@ def test_capture_writes_camera_json_with_its_provenance(calibrated):
     assert provenance["bodyfit_version"] and provenance["time"].endswith("+00:00")
     assert load_camera(output).board == parse_board("chessboard:9x6", 25)
     coverage = cv2.imread(str(output.with_name("camera_coverage.png")))
-    assert coverage.shape[1] == 1200 and coverage.shape[0] == 675
+    # The frame (1280x720 scaled to 1200x675), then the legend: 3 lines and 3 lines of 4 views.
+    assert coverage.shape[1] == 1200 and coverage.shape[0] == 675 + (3 + 3) * 24 + 10
 
 
 def test_capture_prints_the_summary(chessboard_shots, tmp_path, run_calib):
