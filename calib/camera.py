@@ -30,6 +30,7 @@ __all__ = ["CAMERA_FORMAT", "DIST_LENGTHS", "CalibrationInput", "Camera", "camer
 
 CAMERA_FORMAT = "bodyfit.camera/1"
 DIST_LENGTHS = (4, 5, 8, 12, 14)
+MAX_IMAGE_SIDE_PX = 100_000  # larger than any camera's; guards against absurd sizes
 
 
 @dataclass(frozen=True)
@@ -95,6 +96,21 @@ def camera_fields(camera: Camera) -> dict:
     return fields
 
 
+def _is_number(value: object) -> bool:
+    """A JSON number that fits a float (not a bool, not an integer beyond float range)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        float(value)
+    except OverflowError:
+        return False
+    return True
+
+
+def _is_whole(value: object, lowest: int, highest: int) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and lowest <= value <= highest
+
+
 def _fail(path: Path, problem: str) -> UserError:
     return UserError(f"camera file {path}: {problem}; run `calib capture` again to make a new one")
 
@@ -119,12 +135,12 @@ def load_camera(path: str | Path) -> Camera:
         raise _fail(path, f"missing {', '.join(missing)}")
 
     size = record["image_size_px"]
-    if not (isinstance(size, list) and len(size) == 2 and all(isinstance(v, int) and v > 0 for v in size)):
-        raise _fail(path, f"image_size_px must be [width, height] in whole pixels, got {size!r}")
+    if not (isinstance(size, list) and len(size) == 2 and all(_is_whole(v, 1, MAX_IMAGE_SIDE_PX) for v in size)):
+        raise _fail(path, f"image_size_px must be [width, height] in whole pixels (1 to {MAX_IMAGE_SIDE_PX})")
     try:
         K = np.array(record["K"], dtype=np.float64)
         dist = np.array(record["dist"], dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # OverflowError: integers beyond float range
         raise _fail(path, "K and dist must hold numbers only") from None
     if K.shape != (3, 3) or not np.isfinite(K).all():
         raise _fail(path, f"K must be a 3x3 matrix of finite numbers, got shape {K.shape}")
@@ -144,8 +160,8 @@ def load_camera(path: str | Path) -> Camera:
         except UserError as error:
             raise _fail(path, f"board: {error}") from None
     rms = record.get("rms_px")
-    if rms is not None and not (isinstance(rms, (int, float)) and math.isfinite(rms) and rms >= 0):
-        raise _fail(path, f"rms_px must be a non-negative number, got {rms!r}")
+    if rms is not None and not (_is_number(rms) and math.isfinite(rms) and rms >= 0):
+        raise _fail(path, "rms_px must be a non-negative number")
     inputs = _calibration_inputs(path, record.get("provenance"))
     return Camera((size[0], size[1]), K, dist, board, None if rms is None else float(rms), inputs)
 

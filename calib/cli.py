@@ -319,6 +319,10 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as stop:  # --help, --version, usage errors: argparse has printed its message
         return int(stop.code or 0)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s: %(message)s")
+    # OpenCV logs decoder complaints (a corrupt TIFF, ...) on stderr; the one-line error says it.
+    cv2.utils.logging.setLogLevel(
+        cv2.utils.logging.LOG_LEVEL_INFO if args.verbose else cv2.utils.logging.LOG_LEVEL_SILENT
+    )
     try:
         if args.command == "capture":
             _capture(args, ["calib", *argv])
