@@ -5,7 +5,11 @@ Two kinds of planar board are supported:
 - ``chessboard:COLSxROWS`` -- a plain chessboard; COLS x ROWS counts the *inner corners*
   (where four squares meet), as OpenCV does. The whole board must be visible in a view.
   Found with ``cv2.findChessboardCornersSB`` and refined with ``cv2.cornerSubPix`` (on
-  rendered boards the refinement halves SB's corner error, and costs ~1 ms).
+  rendered boards the refinement halves SB's corner error, and costs ~1 ms). When SB
+  misses the board (a white board on a white wall, steep views, uneven light), detection
+  falls back through :data:`CHESSBOARD_ATTEMPTS` before it gives up. The detectors number
+  the corners from either end, so the grid is put in one canonical order
+  (:func:`canonical_chessboard_order`) whichever detector found it.
 - ``charuco:COLSxROWS`` -- a ChArUco board; COLS x ROWS counts the *squares*. ArUco
   markers in the white squares identify every corner, so a partly visible board still
   gives a view. Found with OpenCV 5's ``cv2.aruco.CharucoDetector``, refined with
@@ -29,10 +33,12 @@ from bodyfit.calib.errors import UserError
 
 __all__ = [
     "BOARD_KINDS",
+    "CHESSBOARD_ATTEMPTS",
     "BoardDetection",
     "BoardDetector",
     "BoardPicture",
     "BoardSpec",
+    "canonical_chessboard_order",
     "parse_board",
     "render_board",
 ]
@@ -42,8 +48,16 @@ BOARD_KINDS = ("chessboard", "charuco")
 # A ChArUco view with fewer corners than this is too weak to constrain its own pose.
 MIN_CHARUCO_CORNERS = 6
 
-# CALIB_CB_ACCURACY would triple the detection time for a worse result than cornerSubPix.
-_CHESSBOARD_FLAGS = cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_EXHAUSTIVE
+# (detector, flags) tried in turn until one finds the chessboard; the later ones run only
+# when the earlier fail. SB without NORMALIZE_IMAGE finds boards whose white margin merges
+# with a light background; the classic detector finds steep views SB misses. (Both occur
+# on OpenCV's own sample photos.) CALIB_CB_ACCURACY would triple SB's detection time for a
+# worse result than cornerSubPix.
+CHESSBOARD_ATTEMPTS = (
+    ("SB", cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_EXHAUSTIVE),
+    ("SB", cv2.CALIB_CB_EXHAUSTIVE),
+    ("classic", cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE),
+)
 _SUBPIX_CRITERIA = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, 100, 1e-4)
 
 
@@ -249,15 +263,66 @@ class BoardDetector:
         if gray.ndim != 2 or gray.dtype != np.uint8:
             raise ValueError(f"detect() takes an (H, W) uint8 image, got {gray.shape} {gray.dtype}")
         if self.spec.kind == "chessboard":
-            found, corners = cv2.findChessboardCornersSB(
-                gray, (self.spec.columns, self.spec.rows), flags=_CHESSBOARD_FLAGS
-            )
-            if not found:
+            corners = _find_chessboard(gray, (self.spec.columns, self.spec.rows))
+            if corners is None:
                 return None
             ids = np.arange(self.spec.corner_count, dtype=np.int32)
-            return BoardDetection(self._refine(gray, corners), self._object_points, ids)
+            ordered = canonical_chessboard_order(gray, corners, self.spec.columns, self.spec.rows)
+            return BoardDetection(self._refine(gray, ordered), self._object_points, ids)
         corners, ids, _, _ = self._charuco.detectBoard(gray)
         if ids is None or len(ids) < MIN_CHARUCO_CORNERS or self._board.checkCharucoCornersCollinear(ids):
             return None
         ids = ids.reshape(-1).astype(np.int32)
         return BoardDetection(self._refine(gray, corners), self._object_points[ids], ids)
+
+
+def _find_chessboard(gray: np.ndarray, pattern: tuple[int, int]) -> np.ndarray | None:
+    """(N, 2) float32 corners, pixels, from the first of :data:`CHESSBOARD_ATTEMPTS` that finds
+    the board (``pattern`` = (columns, rows) inner corners), or None when none does."""
+    for detector, flags in CHESSBOARD_ATTEMPTS:
+        find = cv2.findChessboardCornersSB if detector == "SB" else cv2.findChessboardCorners
+        found, corners = find(gray, pattern, flags=flags)
+        if found:
+            return corners.reshape(-1, 2)
+    return None
+
+
+def _first_cell_is_dark(gray: np.ndarray, grid: np.ndarray) -> bool:
+    """Whether the squares of the first square's colour (cells (i, j) with i + j even) are
+    darker than the others; ``grid`` is (rows, columns, 2) corners, pixels."""
+    centres = (grid[:-1, :-1] + grid[1:, :-1] + grid[:-1, 1:] + grid[1:, 1:]) / 4
+    height, width = gray.shape
+    xs = np.clip(np.rint(centres[..., 0]).astype(int), 0, width - 1)
+    ys = np.clip(np.rint(centres[..., 1]).astype(int), 0, height - 1)
+    levels = cv2.blur(gray, (3, 3))[ys, xs].astype(np.float64)
+    even = np.add.outer(np.arange(levels.shape[0]), np.arange(levels.shape[1])) % 2 == 0
+    return bool(levels[even].mean() < levels[~even].mean())
+
+
+def canonical_chessboard_order(gray: np.ndarray, corners: np.ndarray, columns: int, rows: int) -> np.ndarray:
+    """The detected corners renumbered in the order of the printed board's object points.
+
+    OpenCV's detectors return the grid row by row, but starting from either end (SB and
+    the classic detector often disagree on the same photo), possibly mirrored. The
+    canonical order, as :func:`render_board` draws it: seen from the front, the board's
+    x axis (along a row) turned clockwise gives its y axis (down the columns), and the
+    square between the first four corners is black. When the board looks the same turned
+    half round (columns + rows even) or a quarter round (square boards), the candidate
+    whose first corner lies nearest the image's top-left corner is taken.
+
+    Args:
+        gray: (H, W) uint8, the image the corners were found in.
+        corners: (columns * rows, 2) corners, pixels, row by row.
+
+    Returns:
+        (columns * rows, 2) float32, the same corners in canonical order.
+    """
+    grid = np.asarray(corners, np.float32).reshape(rows, columns, 2)
+    along_x = (grid[:, -1] - grid[:, 0]).mean(axis=0)
+    along_y = (grid[-1] - grid[0]).mean(axis=0)
+    if along_x[0] * along_y[1] - along_x[1] * along_y[0] < 0:  # mirrored: the y axis turns the other way
+        grid = grid[::-1]
+    turns = (0, 1, 2, 3) if columns == rows else (0, 2)
+    candidates = [np.rot90(grid, turn) for turn in turns]
+    best = min(candidates, key=lambda g: (not _first_cell_is_dark(gray, g), float(g[0, 0].sum())))
+    return np.ascontiguousarray(best.reshape(-1, 2))

@@ -8,7 +8,10 @@ camera.json is a readable JSON object. :func:`load_camera` needs only these fiel
   [, s1, s2, s3, s4[, tx, ty]]]]), 4, 5, 8, 12 or 14 numbers, unitless.
 
 ``calib capture`` adds ``format``, ``board``, ``rms_px`` and the calibration report
-(standard deviations, per-view errors, settings, provenance); see docs/calib.md.
+(standard deviations, per-view errors, settings, provenance); see docs/calib.md. Of the
+provenance, :func:`load_camera` reads ``inputs`` (the paths given to ``calib capture``)
+and ``input_sha256`` (their contents' SHA-256, parallel to ``inputs``; absent in older
+files), so that ``calib check`` can tell held-out photos from calibration photos.
 """
 
 from __future__ import annotations
@@ -23,10 +26,24 @@ import numpy as np
 from bodyfit.calib.boards import BoardSpec
 from bodyfit.calib.errors import UserError
 
-__all__ = ["CAMERA_FORMAT", "DIST_LENGTHS", "Camera", "camera_fields", "load_camera"]
+__all__ = ["CAMERA_FORMAT", "DIST_LENGTHS", "CalibrationInput", "Camera", "camera_fields", "load_camera"]
 
 CAMERA_FORMAT = "bodyfit.camera/1"
 DIST_LENGTHS = (4, 5, 8, 12, 14)
+MAX_IMAGE_SIDE_PX = 100_000  # larger than any camera's; guards against absurd sizes
+
+
+@dataclass(frozen=True)
+class CalibrationInput:
+    """A photo or video the camera was calibrated from.
+
+    Attributes:
+        path: as given to ``calib capture`` (relative to the folder it ran in).
+        sha256: hex SHA-256 of the file's bytes; None in files that did not record it.
+    """
+
+    path: str
+    sha256: str | None
 
 
 @dataclass(frozen=True)
@@ -39,6 +56,7 @@ class Camera:
         dist: (n,) float64 distortion coefficients, OpenCV order, n in 4, 5, 8, 12, 14.
         board: the board it was calibrated with, if known (``calib check`` reuses it).
         rms_px: RMS reprojection error of the calibration, pixels, if known.
+        inputs: the inputs it was calibrated from, if known (from camera.json's provenance).
     """
 
     image_size_px: tuple[int, int]
@@ -46,6 +64,7 @@ class Camera:
     dist: np.ndarray
     board: BoardSpec | None = None
     rms_px: float | None = None
+    inputs: tuple[CalibrationInput, ...] = ()
 
     def check_image(self, image: np.ndarray, name: str) -> None:
         """Raise UserError unless ``image`` ((H, W, ...) array) has this camera's size."""
@@ -77,6 +96,21 @@ def camera_fields(camera: Camera) -> dict:
     return fields
 
 
+def _is_number(value: object) -> bool:
+    """A JSON number that fits a float (not a bool, not an integer beyond float range)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        float(value)
+    except OverflowError:
+        return False
+    return True
+
+
+def _is_whole(value: object, lowest: int, highest: int) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and lowest <= value <= highest
+
+
 def _fail(path: Path, problem: str) -> UserError:
     return UserError(f"camera file {path}: {problem}; run `calib capture` again to make a new one")
 
@@ -101,12 +135,12 @@ def load_camera(path: str | Path) -> Camera:
         raise _fail(path, f"missing {', '.join(missing)}")
 
     size = record["image_size_px"]
-    if not (isinstance(size, list) and len(size) == 2 and all(isinstance(v, int) and v > 0 for v in size)):
-        raise _fail(path, f"image_size_px must be [width, height] in whole pixels, got {size!r}")
+    if not (isinstance(size, list) and len(size) == 2 and all(_is_whole(v, 1, MAX_IMAGE_SIDE_PX) for v in size)):
+        raise _fail(path, f"image_size_px must be [width, height] in whole pixels (1 to {MAX_IMAGE_SIDE_PX})")
     try:
         K = np.array(record["K"], dtype=np.float64)
         dist = np.array(record["dist"], dtype=np.float64)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # OverflowError: integers beyond float range
         raise _fail(path, "K and dist must hold numbers only") from None
     if K.shape != (3, 3) or not np.isfinite(K).all():
         raise _fail(path, f"K must be a 3x3 matrix of finite numbers, got shape {K.shape}")
@@ -126,6 +160,26 @@ def load_camera(path: str | Path) -> Camera:
         except UserError as error:
             raise _fail(path, f"board: {error}") from None
     rms = record.get("rms_px")
-    if rms is not None and not (isinstance(rms, (int, float)) and math.isfinite(rms) and rms >= 0):
-        raise _fail(path, f"rms_px must be a non-negative number, got {rms!r}")
-    return Camera((size[0], size[1]), K, dist, board, None if rms is None else float(rms))
+    if rms is not None and not (_is_number(rms) and math.isfinite(rms) and rms >= 0):
+        raise _fail(path, "rms_px must be a non-negative number")
+    inputs = _calibration_inputs(path, record.get("provenance"))
+    return Camera((size[0], size[1]), K, dist, board, None if rms is None else float(rms), inputs)
+
+
+def _calibration_inputs(path: Path, provenance: object) -> tuple[CalibrationInput, ...]:
+    """The provenance's ``inputs`` with their ``input_sha256``; () without a provenance."""
+    if provenance is None:
+        return ()
+    if not isinstance(provenance, dict):
+        raise _fail(path, "provenance must be an object")
+    inputs = provenance.get("inputs", [])
+    if not (isinstance(inputs, list) and all(isinstance(item, str) for item in inputs)):
+        raise _fail(path, "provenance.inputs must be a list of paths")
+    hashes = provenance.get("input_sha256", [None] * len(inputs))
+    if not (
+        isinstance(hashes, list)
+        and len(hashes) == len(inputs)
+        and all(item is None or isinstance(item, str) for item in hashes)
+    ):
+        raise _fail(path, "provenance.input_sha256 must list one hash per input")
+    return tuple(CalibrationInput(item, digest) for item, digest in zip(inputs, hashes))

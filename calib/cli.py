@@ -28,10 +28,10 @@ from bodyfit.calib.capture import (
     collect_views,
     describe_views,
 )
-from bodyfit.calib.check import check_calibration
+from bodyfit.calib.check import CheckedView, check_calibration, rms_px
 from bodyfit.calib.coverage import coverage_fraction, coverage_picture
 from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import check_writable_dir, write_atomic
+from bodyfit.calib.files import check_writable_dir, file_sha256, write_atomic
 from bodyfit.calib.images import encode_image, read_photo, to_upright, write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.calib.undistort import undistort_image
@@ -129,7 +129,8 @@ def _build_parser() -> argparse.ArgumentParser:
     check = commands.add_parser(
         "check",
         help="reprojection error of a calibration on held-out board photos",
-        description="Reprojection error (pixels) of camera.json on board photos it was not solved from. "
+        description="Reprojection error (pixels) of camera.json on board photos it was not solved from; "
+        "photos it was solved from (recognised by content) are reported apart. "
         "Uses the board recorded in camera.json unless --board is given.",
     )
     check.add_argument("camera", metavar="camera.json")
@@ -190,6 +191,7 @@ def _capture(args: argparse.Namespace, argv: list[str]) -> None:
         "provenance": {
             "argv": argv,
             "inputs": list(args.inputs),
+            "input_sha256": [file_sha256(path) for path in args.inputs],
             "bodyfit_version": _version(),
             "opencv_version": cv2.__version__,
             "time": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
@@ -229,16 +231,34 @@ def _check(args: argparse.Namespace) -> None:
         spec = camera.board
     else:
         raise UserError(f"{args.camera} records no board; give --board and --square-mm")
-    views, rms = check_calibration(camera, args.inputs, BoardDetector(spec))
+    views = check_calibration(camera, args.inputs, BoardDetector(spec))
     for view in views:
+        seen = ", calibrated on it" if view.calibrated_on else ""
         if view.error_px is not None:
-            print(f"  {view.name}: error {view.error_px:.3f} px ({view.corners} corners)")
+            print(f"  {view.name}: error {view.error_px:.3f} px ({view.corners} corners){seen}")
         else:
-            print(f"  {view.name}: {'no board' if view.corners == 0 else 'pose not found'}")
-    found = sum(view.error_px is not None for view in views)
-    print(f"held-out RMS reprojection error {rms:.3f} px over {found} of {len(views)} views")
+            print(f"  {view.name}: {'no board' if view.corners == 0 else 'pose not found'}{seen}")
+    held_out = [view for view in views if not view.calibrated_on]
+    calibrated_on = [view for view in views if view.calibrated_on]
+    if held_out:
+        print(f"held-out RMS reprojection error {_group_error(held_out)}")
+    if calibrated_on:
+        print(
+            f"RMS reprojection error on {len(calibrated_on)} photo{'s' if len(calibrated_on) != 1 else ''} "
+            "the camera was calibrated on "
+            f"(not held out): {_group_error(calibrated_on)}"
+        )
     if camera.rms_px is not None:
         print(f"calibration RMS reprojection error {camera.rms_px:.3f} px")
+
+
+def _group_error(views: list[CheckedView]) -> str:
+    """``0.045 px over 3 of 4 views``, or ``not measured: no board found in 4 views``."""
+    rms = rms_px(views)
+    if rms is None:
+        return f"not measured: no board found in {len(views)} views"
+    found = sum(view.error_px is not None for view in views)
+    return f"{rms:.3f} px over {found} of {len(views)} views"
 
 
 def _undistort(args: argparse.Namespace) -> None:
@@ -299,6 +319,10 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as stop:  # --help, --version, usage errors: argparse has printed its message
         return int(stop.code or 0)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, format="%(name)s: %(message)s")
+    # OpenCV logs decoder complaints (a corrupt TIFF, ...) on stderr; the one-line error says it.
+    cv2.utils.logging.setLogLevel(
+        cv2.utils.logging.LOG_LEVEL_INFO if args.verbose else cv2.utils.logging.LOG_LEVEL_SILENT
+    )
     try:
         if args.command == "capture":
             _capture(args, ["calib", *argv])

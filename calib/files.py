@@ -1,4 +1,4 @@
-"""Atomic output files: a reader never sees a half-written result.
+"""Atomic output files (a reader never sees a half-written result), and input fingerprints.
 
 Every output of the `calib` and `fitter` commands goes through :func:`write_atomic`: the
 bytes are written to a temporary file in the destination folder and renamed over the
@@ -11,13 +11,14 @@ that fails removes the folders it created, so a failed command leaves nothing be
 
 from __future__ import annotations
 
+import hashlib
 import os
 import secrets
 from pathlib import Path
 
 from bodyfit.calib.errors import UserError
 
-__all__ = ["check_writable_dir", "write_atomic"]
+__all__ = ["check_writable_dir", "file_sha256", "write_atomic"]
 
 
 def _nearest_existing(path: Path) -> Path:
@@ -65,17 +66,36 @@ def write_atomic(path: str | os.PathLike, payload: bytes) -> None:
     # open(..., "xb") rather than mkstemp: the file gets the umask's permissions, not 0600.
     temp_name = folder / f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
     created: list[Path] = []
+    temp_made = False
     try:
         created = _make_folders(folder)
         with open(temp_name, "xb") as stream:
+            temp_made = True
             stream.write(payload)
             stream.flush()
             os.fsync(stream.fileno())
         os.replace(temp_name, target)
+        temp_made = False
         created = []
     except OSError as error:
         raise UserError(f"cannot write {target}: {error.strerror or error}") from None
     finally:
-        temp_name.unlink(missing_ok=True)  # gone already after a successful rename
+        if temp_made:  # only when open() succeeded: a name too long cannot even be unlinked
+            temp_name.unlink(missing_ok=True)
         for folder_made in created:
             folder_made.rmdir()
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """Hex SHA-256 of a file's bytes: recognises an input however its path is spelled.
+
+    Raises UserError when the file cannot be read.
+    """
+    digest = hashlib.sha256()
+    try:
+        with open(path, "rb") as stream:
+            for block in iter(lambda: stream.read(1 << 20), b""):
+                digest.update(block)
+    except OSError as error:
+        raise UserError(f"{path}: cannot read it ({error.strerror or error})") from None
+    return digest.hexdigest()

@@ -33,6 +33,7 @@ __all__ = [
     "frame_name",
     "is_video",
     "read_frames",
+    "read_image_file",
     "read_photo",
     "sample_video_frames",
     "to_upright",
@@ -83,14 +84,27 @@ def _exif_orientation(exif: bytes) -> int:
     return 1
 
 
-def read_photo(path: str | Path) -> Photo:
-    """Read a photo in the sensor frame, with its EXIF orientation; UserError if unreadable."""
+def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, list]:
+    """``cv2.imreadWithMetadata(path, flags)``: (pixels, metadata kinds, metadata blocks).
+
+    Raises UserError when the file is missing or OpenCV cannot decode it (corrupt,
+    truncated, not an image, or declaring more pixels than OpenCV accepts).
+    """
     path = Path(path)
     if not path.is_file():
         raise UserError(f"{path}: no such file")
-    pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), cv2.IMREAD_COLOR | cv2.IMREAD_IGNORE_ORIENTATION)
+    try:
+        pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), flags)
+    except cv2.error:  # e.g. a header claiming a width above CV_IO_MAX_IMAGE_WIDTH
+        pixels, kinds, blocks = None, [], []
     if pixels is None or pixels.size == 0:
         raise UserError(f"{path}: not a readable image (OpenCV cannot decode it)")
+    return pixels, kinds, blocks
+
+
+def read_photo(path: str | Path) -> Photo:
+    """Read a photo in the sensor frame, with its EXIF orientation; UserError if unreadable."""
+    pixels, kinds, blocks = read_image_file(path, cv2.IMREAD_COLOR | cv2.IMREAD_IGNORE_ORIENTATION)
     orientation = 1
     for kind, block in zip(np.asarray(kinds).reshape(-1), blocks):
         if kind == cv2.IMAGE_METADATA_EXIF:

@@ -46,7 +46,7 @@ from kornia.morphology import closing, opening
 
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
-from bodyfit.calib.images import read_photo, to_upright
+from bodyfit.calib.images import read_image_file, read_photo, to_upright
 from bodyfit.calib.undistort import undistort_image
 
 __all__ = ["SilhouetteSettings", "extract_silhouette", "load_mask", "photo_silhouette"]
@@ -55,6 +55,10 @@ log = logging.getLogger(__name__)
 
 _MAX_BORDER_SAMPLES = 40_000
 _SIDE_NAMES = ("top", "bottom", "left", "right")
+
+
+# Smaller photos leave the backdrop fit and the filters nothing to work on.
+MIN_PHOTO_SIDE_PX = 64
 
 
 @dataclass(frozen=True)
@@ -275,6 +279,11 @@ def extract_silhouette(
         raise ValueError(
             f"extract_silhouette() takes an (H, W, 3) uint8 image, got {image_bgr.shape} {image_bgr.dtype}"
         )
+    if min(image_bgr.shape[:2]) < MIN_PHOTO_SIDE_PX:
+        raise UserError(
+            f"the photo is {image_bgr.shape[1]}x{image_bgr.shape[0]} pixels; a silhouette needs a photo of at "
+            f"least {MIN_PHOTO_SIDE_PX} pixels each way (use the camera's full resolution)"
+        )
     band = _border_band(image_bgr.shape[:2], settings.border_band_fraction)
     if background is None:
         backdrop = _fit_backdrop(image_bgr, band)
@@ -328,11 +337,7 @@ def load_mask(path: str | Path) -> np.ndarray:
     ``calib undistort``). Raises UserError when it cannot be read or is empty.
     """
     path = Path(path)
-    if not path.is_file():
-        raise UserError(f"{path}: no such file")
-    pixels = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE)
-    if pixels is None:
-        raise UserError(f"{path}: not a readable image (OpenCV cannot decode it)")
+    pixels, _, _ = read_image_file(path, cv2.IMREAD_GRAYSCALE)
     mask = pixels > 127
     if not mask.any() or mask.all():
         raise UserError(

@@ -25,3 +25,11 @@ def measurer(body_model):
     from bodyfit.fitter.measurements import Measurer
 
     return Measurer.from_model(body_model)
+
+
+# Property-based tests (hypothesis): derandomized, so CI runs the same cases every time, and
+# no per-example deadline (image decoding times vary between machines).
+from hypothesis import settings  # noqa: E402
+
+settings.register_profile("bodyfit", derandomize=True, deadline=None, max_examples=150)
+settings.load_profile("bodyfit")

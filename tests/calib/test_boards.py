@@ -4,7 +4,14 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.calib.boards import BoardDetector, BoardSpec, parse_board, render_board
+from bodyfit.calib.boards import (
+    CHESSBOARD_ATTEMPTS,
+    BoardDetector,
+    BoardSpec,
+    canonical_chessboard_order,
+    parse_board,
+    render_board,
+)
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.synthetic import BoardPhotoRenderer
 
@@ -84,3 +91,73 @@ def test_detect_returns_none_without_a_board():
     blank = np.full((SIZE[1], SIZE[0]), 128, np.uint8)
     assert BoardDetector(parse_board("chessboard:7x5", 25.0)).detect(blank) is None
     assert BoardDetector(parse_board("charuco:7x5", 25.0, 18.0, "DICT_4X4_50")).detect(blank) is None
+
+
+# --- boards the first detector misses: a white board on a white wall, steep views ---------
+
+# Like OpenCV's sample photos left01..14.jpg: 640x480 grey, a 9x6 board printed with a white
+# margin, here hung on a wall as light as the paper, seen 50-60 degrees off its axis.
+WALL_K = np.array([[540.0, 0.0, 320.0], [0.0, 540.0, 240.0], [0.0, 0.0, 1.0]])
+WALL_SIZE = (640, 480)
+WALL_SPEC = parse_board("chessboard:9x6", 25.0)
+STEEP_POSES = {
+    # SB without NORMALIZE_IMAGE finds it (and numbers it from the far end).
+    "second SB attempt": (np.array([0.744, -0.783, 0.524]), np.array([99.1, -44.37, 355.18])),
+    # Only the classic detector finds it.
+    "classic detector": (np.array([-0.893, 0.364, 0.307]), np.array([13.39, -176.23, 584.41])),
+}
+
+
+def _board_on_a_white_wall(pose):
+    """(photo (480, 640) uint8, true corners (54, 2) in the detector's object-point order, pixels)."""
+    rvec, tvec = pose
+    renderer = BoardPhotoRenderer(render_board(WALL_SPEC, 40), WALL_K, NO_DIST, WALL_SIZE)
+    photo = renderer.render(rvec, tvec, noise_sigma=2.0, rng=np.random.default_rng(5), background=235.0)
+    object_points = BoardDetector(WALL_SPEC).detect(photo).object_points
+    truth, _ = cv2.projectPoints(object_points, rvec, tvec, WALL_K, NO_DIST)
+    return photo, truth.reshape(-1, 2)
+
+
+def _first_attempt_finds(photo):
+    _, flags = CHESSBOARD_ATTEMPTS[0]
+    return cv2.findChessboardCornersSB(photo, (WALL_SPEC.columns, WALL_SPEC.rows), flags=flags)[0]
+
+
+@pytest.mark.parametrize("case", list(STEEP_POSES))
+def test_a_board_the_first_detector_misses_is_found_by_a_fallback(case):
+    photo, truth = _board_on_a_white_wall(STEEP_POSES[case])
+    assert not _first_attempt_finds(photo)  # the case really needs a fallback
+    detection = BoardDetector(WALL_SPEC).detect(photo)
+    assert detection is not None
+    # Canonical order: the corners match the object points' projections one by one.
+    assert np.abs(detection.image_points - truth).max() < 0.5
+
+
+def test_sb_and_the_classic_detector_give_one_corner_order():
+    photo, truth = _board_on_a_white_wall(STEEP_POSES["second SB attempt"])
+    pattern = (WALL_SPEC.columns, WALL_SPEC.rows)
+    found_sb, sb = cv2.findChessboardCornersSB(photo, pattern, flags=cv2.CALIB_CB_EXHAUSTIVE)
+    found_classic, classic = cv2.findChessboardCorners(photo, pattern, flags=CHESSBOARD_ATTEMPTS[2][1])
+    assert found_sb and found_classic
+    sb, classic = sb.reshape(-1, 2), classic.reshape(-1, 2)
+    assert np.abs(sb[::-1] - classic).max() < 3  # the two detectors start from opposite ends here
+    for corners in (sb, classic):
+        ordered = canonical_chessboard_order(photo, corners, *pattern)
+        assert np.abs(ordered - truth).max() < 3  # unrefined corners, but the same order as the truth
+
+
+@pytest.mark.parametrize("spec_text", ["chessboard:9x6", "chessboard:7x5", "chessboard:6x6"])
+def test_canonical_order_undoes_any_numbering_of_the_grid(spec_text):
+    spec = parse_board(spec_text, 25.0)
+    photo, rvec, tvec = _frontal_photo(spec)
+    truth, _ = cv2.projectPoints(BoardDetector(spec).detect(photo).object_points, rvec, tvec, K, NO_DIST)
+    grid = truth.reshape(spec.rows, spec.columns, 2)
+    canonical = canonical_chessboard_order(photo, grid.reshape(-1, 2), spec.columns, spec.rows)
+    numberings = [grid[::-1, ::-1], grid[::-1], grid[:, ::-1]]
+    if spec.columns == spec.rows:
+        numberings += [np.rot90(grid), np.rot90(grid, 3), np.swapaxes(grid, 0, 1)]
+    for numbering in numberings:
+        reordered = canonical_chessboard_order(photo, numbering.reshape(-1, 2), spec.columns, spec.rows)
+        np.testing.assert_array_equal(reordered, canonical)
+    if (spec.columns + spec.rows) % 2:  # not symmetric: the colours fix the order to the truth's
+        np.testing.assert_array_equal(canonical, truth.reshape(-1, 2).astype(np.float32))

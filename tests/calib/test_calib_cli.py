@@ -1,5 +1,6 @@
 """The `calib` command: what it writes, what it prints, and one-line errors for bad input."""
 
+import hashlib
 import json
 
 import cv2
@@ -18,10 +19,11 @@ CHESSBOARD = ("--board", "chessboard:9x6", "--square-mm", "25")
 
 @pytest.fixture(scope="module")
 def calibrated(tmp_path_factory, chessboard_shots):
-    """camera.json from `calib capture` on the first 9 views plus the blurred one."""
+    """camera.json from `calib capture` on the first 9 views plus the blurred one, written
+    into a folder that does not exist yet (with the default coverage picture beside it)."""
     from bodyfit.calib.cli import main
 
-    folder = tmp_path_factory.mktemp("capture")
+    folder = tmp_path_factory.mktemp("capture") / "new" / "calibration"
     output = folder / "camera.json"
     inputs = [str(p) for p in chessboard_shots.sharp[:9]] + [str(chessboard_shots.blurred)]
     assert main(["capture", *inputs, *CHESSBOARD, "-o", str(output)]) == 0
@@ -46,10 +48,12 @@ def test_capture_writes_camera_json_with_its_provenance(calibrated):
     assert 0 < record["coverage_fraction"] <= 1
     provenance = record["provenance"]
     assert provenance["argv"][:2] == ["calib", "capture"] and provenance["inputs"] == inputs
+    assert provenance["input_sha256"] == [hashlib.sha256(open(p, "rb").read()).hexdigest() for p in inputs]
     assert provenance["bodyfit_version"] and provenance["time"].endswith("+00:00")
     assert load_camera(output).board == parse_board("chessboard:9x6", 25)
     coverage = cv2.imread(str(output.with_name("camera_coverage.png")))
-    assert coverage.shape[1] == 1200 and coverage.shape[0] == 675
+    # The frame (1280x720 scaled to 1200x675), then the legend: 3 lines and 3 lines of 4 views.
+    assert coverage.shape[1] == 1200 and coverage.shape[0] == 675 + (3 + 3) * 24 + 10
 
 
 def test_capture_prints_the_summary(chessboard_shots, tmp_path, run_calib):
@@ -59,9 +63,9 @@ def test_capture_prints_the_summary(chessboard_shots, tmp_path, run_calib):
         chessboard_shots.bent,
         *CHESSBOARD,
         "-o",
-        tmp_path / "cam.json",
+        tmp_path / "cameras" / "cam.json",  # neither folder exists yet: both are created
         "--coverage",
-        tmp_path / "cover.png",
+        tmp_path / "pictures" / "cover.png",
     )
     assert result.code == 0, result.stderr
     out = result.stdout
@@ -69,8 +73,8 @@ def test_capture_prints_the_summary(chessboard_shots, tmp_path, run_calib):
     assert "RMS reprojection error" in out and "worst view" in out
     for name in ("fx", "fy", "cx", "cy", "k1", "k2"):
         assert f"  {name} = " in out
-    assert "±" in out and f"wrote {tmp_path / 'cam.json'}" in out
-    assert (tmp_path / "cover.png").is_file()
+    assert "±" in out and f"wrote {tmp_path / 'cameras' / 'cam.json'}" in out
+    assert (tmp_path / "pictures" / "cover.png").is_file()
 
 
 def test_check_reports_the_error_on_held_out_photos(calibrated, chessboard_shots, run_calib):
@@ -83,14 +87,50 @@ def test_check_reports_the_error_on_held_out_photos(calibrated, chessboard_shots
     rms = float(held_out_line.split()[4])
     assert 0 < rms < 0.2
     assert f"over {len(held_out)} of {len(held_out)} views" in held_out_line
+    assert "calibrated on" not in result.stdout
+
+
+def test_check_reports_calibration_photos_apart_from_held_out_ones(calibrated, chessboard_shots, tmp_path, run_calib):
+    output, _ = calibrated
+    renamed = tmp_path / "renamed.png"  # a calibration photo under another name: same bytes
+    renamed.write_bytes(chessboard_shots.sharp[0].read_bytes())
+    result = run_calib("check", output, renamed, chessboard_shots.sharp[1], chessboard_shots.sharp[10])
+    assert result.code == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert f"  {renamed}: error" in result.stdout and lines[0].endswith(", calibrated on it")
+    assert lines[1].endswith(", calibrated on it") and not lines[2].endswith("calibrated on it")
+    assert any(line.startswith("held-out RMS reprojection error") and "over 1 of 1 views" in line for line in lines)
+    seen = next(line for line in lines if line.startswith("RMS reprojection error on 2 photos"))
+    assert "the camera was calibrated on (not held out): " in seen and "over 2 of 2 views" in seen
+
+    result = run_calib("check", output, chessboard_shots.sharp[2])
+    assert result.code == 0, result.stderr
+    assert "held-out" not in result.stdout
+    assert "RMS reprojection error on 1 photo the camera was calibrated on (not held out)" in result.stdout
+
+
+def test_check_recognises_calibration_photos_by_path_in_files_without_hashes(
+    calibrated, chessboard_shots, tmp_path, run_calib, monkeypatch
+):
+    output, _ = calibrated
+    record = json.loads(output.read_text())
+    del record["provenance"]["input_sha256"]  # as camera files written before hashes were
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(record))
+    monkeypatch.chdir(chessboard_shots.sharp[0].parent)
+    result = run_calib("check", old, chessboard_shots.sharp[0].name, chessboard_shots.sharp[10].name)
+    assert result.code == 0, result.stderr
+    assert "held-out RMS reprojection error" in result.stdout
+    assert "RMS reprojection error on 1 photo the camera was calibrated on (not held out)" in result.stdout
 
 
 def test_undistort_writes_the_kornia_result(calibrated, chessboard_shots, tmp_path, run_calib):
     output, _ = calibrated
     photo = chessboard_shots.sharp[4]
-    result = run_calib("undistort", output, photo, "-o", tmp_path)
+    folder = tmp_path / "undistorted" / "today"  # does not exist yet: created
+    result = run_calib("undistort", output, photo, "-o", folder)
     assert result.code == 0, result.stderr
-    written = cv2.imread(str(tmp_path / photo.name))
+    written = cv2.imread(str(folder / photo.name))
     expected = undistort_image(cv2.imread(str(photo)), load_camera(output))
     np.testing.assert_array_equal(written, expected)
 
@@ -98,9 +138,10 @@ def test_undistort_writes_the_kornia_result(calibrated, chessboard_shots, tmp_pa
 def test_silhouette_writes_the_mask(tmp_path, run_calib):
     photo, truth = studio_photo((720, 960), [(360.0, 60.0, 820.0)], np.random.default_rng(4))
     cv2.imwrite(str(tmp_path / "front.png"), photo)
-    result = run_calib("silhouette", tmp_path / "front.png", "-o", tmp_path / "mask.png")
+    mask_path = tmp_path / "masks" / "front_mask.png"  # the folder does not exist yet: created
+    result = run_calib("silhouette", tmp_path / "front.png", "-o", mask_path)
     assert result.code == 0, result.stderr
-    mask = cv2.imread(str(tmp_path / "mask.png"), cv2.IMREAD_GRAYSCALE)
+    mask = cv2.imread(str(mask_path), cv2.IMREAD_GRAYSCALE)
     assert set(np.unique(mask)) == {0, 255}
     assert iou(mask > 0, truth) >= 0.99
 
@@ -119,11 +160,11 @@ def test_board_draws_a_board_the_detector_finds(tmp_path, run_calib):
         "--dpi",
         "150",
         "-o",
-        tmp_path / "board.png",
+        tmp_path / "prints" / "board.png",  # the folder does not exist yet: created
     )
     assert result.code == 0, result.stderr
     assert "mm squares" in result.stdout
-    picture = cv2.imread(str(tmp_path / "board.png"), cv2.IMREAD_GRAYSCALE)
+    picture = cv2.imread(str(tmp_path / "prints" / "board.png"), cv2.IMREAD_GRAYSCALE)
     assert picture.shape == ((5 + 2) * 177, (7 + 2) * 177)  # 30 mm at 150 dpi: 177 px per square
     detection = BoardDetector(parse_board("charuco:7x5", 30, 22, "DICT_4X4_50")).detect(picture)
     assert detection is not None and len(detection.corner_ids) == 24
@@ -186,25 +227,26 @@ BAD_INPUT_CASES = {
     "no person": (["silhouette", "nobody", "-o", OUT], "no person found"),
     "person touching the frame edge": (["silhouette", "cut", "-o", OUT], "touches the bottom edge"),
     "several people": (["silhouette", "two", "-o", OUT], "2 person-sized regions"),
-    "output folder missing": (["silhouette", "two", "-o", "missing/mask.png"], "does not exist"),
+    "output folder is a file": (["silhouette", "nobody", "-o", "view/mask.png"], "is a file"),
     "usage error": (["capture", "--board", "chessboard:9x6"], "required"),
 }
 
 
 @pytest.mark.parametrize("case", list(BAD_INPUT_CASES))
 def test_bad_input_is_one_line_exit_2_and_nothing_written(case, bad_inputs, tmp_path, run_calib):
+    """Outputs go into a folder that does not exist yet: a failed command must not leave it behind."""
     arguments, complaint = BAD_INPUT_CASES[case]
     out_dir = tmp_path / "out"
     out_dir.mkdir()
-    output = out_dir / "result.json"
+    new_dir = out_dir / "new" / "deeper"
     argv = []
     for argument in arguments:
         if argument == OUT:
-            argv.append(output)
+            argv.append(new_dir / "result.json")
         elif argument == "DIR":
-            argv.append(out_dir)
-        elif argument == "missing/mask.png":
-            argv.append(tmp_path / "missing" / "mask.png")
+            argv.append(new_dir)
+        elif argument == "view/mask.png":
+            argv.append(bad_inputs["view"] / "mask.png")
         else:
             argv.append(bad_inputs.get(argument, argument))
     result = run_calib(*argv)
