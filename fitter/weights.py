@@ -63,9 +63,9 @@ __all__ = ["WEIGHT_NAMES", "PRESETS", "parse_override", "load_weights_file", "re
            "cost_settings", "weights_record", "settings_from_record"]
 
 EXTREME_NAMES = ("top", "bottom")
-VIEW_NAMES = ("view.front", "view.side")
+VIEW_WEIGHT_NAMES = ("view.front", "view.side")
 #: Every weight's name, in the order of a record.
-WEIGHT_NAMES = PART_NAMES + EXTREME_NAMES + VIEW_NAMES
+WEIGHT_NAMES = PART_NAMES + EXTREME_NAMES + VIEW_WEIGHT_NAMES
 
 
 def _preset(*values: float) -> Mapping[str, float]:
@@ -185,7 +185,7 @@ def resolve_weights(choice: str = "paper", overrides: Iterable[str] = ()) -> dic
 def _check_not_degenerate(weights: Mapping[str, float], where: str) -> None:
     if all(weights[name] == 0 for name in PART_NAMES):
         raise UserError(f"{where}: every part weight is 0; give at least one part a weight > 0")
-    if all(weights[name] == 0 for name in VIEW_NAMES):
+    if all(weights[name] == 0 for name in VIEW_WEIGHT_NAMES):
         raise UserError(f"{where}: both view weights are 0; give a view a weight > 0")
 
 
