@@ -458,14 +458,14 @@ class CmaSettings:
     restarts: int = 0
 
 
-#: cma needs finite costs. A failed (+inf) candidate is told to cma as the worst finite
-#: cost of its generation plus max(1, |worst|), so it ranks below every finite one
-#: (CMA-ES uses ranks); a generation without any finite cost is told as all zeros, which
-#: cma sees as flat fitness (it widens its steps, then stops with "tolflatfitness").
 def _finite_costs(costs: np.ndarray) -> np.ndarray:
+    """Costs cma can take, (P,) float64: cma needs finite values, and ranks them.
+
+    A failed (+inf) candidate is told as the worst finite cost of its generation plus
+    max(1, |worst|), so it ranks below every finite one. A generation without any
+    finite cost is not told to cma at all (see ``CmaEvolutionStrategy._tell``).
+    """
     finite = np.isfinite(costs)
-    if not finite.any():
-        return np.zeros_like(costs)
     worst = costs[finite].max()
     return np.where(finite, costs, worst + max(1.0, abs(worst)))
 
@@ -481,8 +481,10 @@ class CmaEvolutionStrategy(Optimizer):
 
     ``stop()`` returns cma's own reasons under cma's names (e.g. ``{"tolfun": 1e-11}``,
     ``{"tolstagnation": ...}``, ``{"tolflatfitness": 1}``) once no restart is left,
-    and ``{"generations": n}`` at the budget. Costs of +inf are told as explained at
-    ``_finite_costs``; ``result`` keeps the true costs. After a restart
+    and ``{"generations": n}`` at the budget (restarts share it). A generation where every
+    candidate failed (+inf) counts against the budget but leaves cma as it was: an
+    all-equal generation would end cma at once ("tolfun"); other +inf costs are ranked
+    last (``_finite_costs``); ``result`` keeps the true costs. After a restart
     ``population_size`` doubles.
     """
 
@@ -525,6 +527,8 @@ class CmaEvolutionStrategy(Optimizer):
         return np.clip(x, self.lower, self.upper)  # rounding only
 
     def _tell(self, candidates: np.ndarray, costs: np.ndarray) -> None:
+        if not np.isfinite(costs).any():
+            return  # all failed: cma keeps its state and samples anew at the next ask
         if np.array_equal(candidates, self._asked):  # cma recognises its own solutions
             normalised = self._asked_normalised
         else:
