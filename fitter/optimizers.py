@@ -336,7 +336,7 @@ class GeneticAlgorithm(Optimizer):
         return self.settings.population
 
     def _ask(self) -> np.ndarray:
-        return self._population_next.copy()
+        return self._population_next
 
     def _tell(self, candidates: np.ndarray, costs: np.ndarray) -> None:
         ranked = candidates[np.argsort(costs, kind="stable")]
