@@ -29,7 +29,7 @@ import dataclasses
 
 import warp as wp
 
-from bodyfit.fitter.body_model import PART_NAMES
+from bodyfit.kernels.body_layout import PART_NAMES
 from bodyfit.kernels.alignment import TargetFrame
 from bodyfit.kernels.boundary import run_end, run_part, run_start, transform_point
 

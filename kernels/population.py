@@ -19,7 +19,7 @@ from typing import NamedTuple, Sequence
 import numpy as np
 import warp as wp
 
-from bodyfit.fitter.body_model import POSE_NAMES
+from bodyfit.kernels.body_layout import POSE_NAMES
 from bodyfit.kernels.alignment import launch_alignment
 from bodyfit.kernels.boundary import BoundaryRuns, allocate_runs, launch_nearest, launch_row_scan
 from bodyfit.kernels.cost import (TERM_NAMES, CostSettings, PartVector, cost_params,

@@ -16,7 +16,7 @@ import numpy as np
 import scipy.ndimage as ndi
 import warp as wp
 
-from bodyfit.fitter.body_model import PART_NAMES
+from bodyfit.kernels.body_layout import PART_NAMES
 from bodyfit.kernels.alignment import SilhouetteFrame, TargetFrame, silhouette_frame
 from bodyfit.kernels.camera import Camera
 from bodyfit.kernels.device import resolve_device

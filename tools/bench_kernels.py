@@ -18,6 +18,7 @@ import argparse
 import os
 import platform
 import resource
+import sys
 import time
 
 import numpy as np
@@ -29,6 +30,7 @@ from bodyfit.fitter.model_cache import load_model
 from bodyfit.kernels.boundary import nearest_boundary
 from bodyfit.kernels.camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.cost import CostSettings
+from bodyfit.kernels.device import resolve_device
 from bodyfit.kernels.population import STAGES, PopulationEvaluator
 from bodyfit.kernels.raster import rasterize
 from bodyfit.kernels.reference import population_cost
@@ -107,8 +109,11 @@ def main() -> None:
 
     wp.config.log_level = wp.LOG_WARNING  # keep Warp's start-up and module lines out
     model = load_model()
-    device = wp.get_device(args.device)
-    arrays = ModelArrays.from_body_model(model, 20, device)
+    try:  # the kernels raise ValueError, with a message for the user, for a bad device
+        device = resolve_device(args.device)
+        arrays = ModelArrays.from_body_model(model, 20, device)
+    except ValueError as exc:
+        sys.exit(f"bench_kernels: error: {exc}")
     views, person = _views(model, args.height, device, args.seed)
     settings = CostSettings()
     num_views = len(views)
