@@ -29,11 +29,11 @@ from typing import TYPE_CHECKING
 _EXPORTS = {
     "PART_NAMES": "body_layout",
     "POSE_NAMES": "body_layout",
-    "Camera": "camera",
-    "FRONT_VIEW_DEG": "camera",
-    "SIDE_VIEW_DEG": "camera",
-    "orthographic_camera": "camera",
-    "pinhole_camera": "camera",
+    "ViewCamera": "view_camera",
+    "FRONT_VIEW_DEG": "view_camera",
+    "SIDE_VIEW_DEG": "view_camera",
+    "orthographic_camera": "view_camera",
+    "pinhole_camera": "view_camera",
     "CostSettings": "cost",
     "MATCHING_DIRECTIONS": "cost",
     "TERM_NAMES": "cost",
@@ -53,14 +53,14 @@ __all__ = list(_EXPORTS)
 
 if TYPE_CHECKING:
     from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES
-    from bodyfit.kernels.camera import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, Camera,
-                                        orthographic_camera, pinhole_camera)
     from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
     from bodyfit.kernels.population import (PopulationCost, PopulationEvaluator,
                                             evaluate_population)
     from bodyfit.kernels.raster import rasterize
     from bodyfit.kernels.skinning import ModelArrays, SkinnableModel, skin
     from bodyfit.kernels.target import SIDE_VIEW_PARTS, ViewTarget, prepare_view_target
+    from bodyfit.kernels.view_camera import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, ViewCamera,
+                                             orthographic_camera, pinhole_camera)
 
 
 def __getattr__(name: str):

@@ -26,13 +26,13 @@ from scipy.spatial import cKDTree
 
 from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES, POSE_SIDES
 from bodyfit.kernels.alignment import rigid_transform, silhouette_frame
-from bodyfit.kernels.camera import Camera, camera_matrices
+from bodyfit.kernels.view_camera import ViewCamera, camera_matrices
 from bodyfit.kernels.cost import MATCHING_WEIGHTS, TERM_NAMES, CostSettings
 from bodyfit.kernels.skinning import SkinnableModel
 from bodyfit.kernels.target import ViewTarget, boundary_mask, visible_faces
 
-__all__ = ["skin_reference", "project_vertices", "render_label_maps", "interpolate_distance", "view_terms",
-           "population_cost"]
+__all__ = ["skin_reference", "project_vertices", "render_label_maps", "interpolate_distance",
+           "view_terms", "population_cost"]
 
 _SHIFT = 8  # fixed-point bits of the cv2.fillPoly coordinates
 _BAND_PIXELS = 1 << 20  # fine-grid pixels painted per band
@@ -67,11 +67,11 @@ def skin_reference(model: SkinnableModel, betas, pose_deg) -> np.ndarray:
     return posed
 
 
-def project_vertices(camera: Camera, vertices: np.ndarray) -> np.ndarray:
+def project_vertices(camera: ViewCamera, vertices: np.ndarray) -> np.ndarray:
     """(..., 3) float64 (u, v, z_cam): pixels (column, row) and depth in metres.
 
     Args:
-        camera: a camera of :mod:`bodyfit.kernels.camera`.
+        camera: a camera of :mod:`bodyfit.kernels.view_camera`.
         vertices: (..., 3) float, metres, model frame.
     """
     k, r, t = camera_matrices(camera)

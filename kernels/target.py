@@ -18,7 +18,7 @@ import warp as wp
 
 from bodyfit.kernels.body_layout import PART_NAMES
 from bodyfit.kernels.alignment import SilhouetteFrame, TargetFrame, silhouette_frame
-from bodyfit.kernels.camera import Camera
+from bodyfit.kernels.view_camera import ViewCamera
 from bodyfit.kernels.device import resolve_device
 
 __all__ = ["VIEW_NAMES", "SIDE_VIEW_PARTS", "ViewTarget", "prepare_view_target",
@@ -82,7 +82,7 @@ class ViewTarget:
     """
 
     name: str
-    camera: Camera
+    camera: ViewCamera
     height: int
     width: int
     millimetres_per_pixel: float
@@ -97,7 +97,7 @@ class ViewTarget:
         return self.frame.to_warp()
 
 
-def prepare_view_target(name: str, mask, camera: Camera, millimetres_per_pixel: float,
+def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pixel: float,
                         visible_parts=PART_NAMES, device: str = "cpu") -> ViewTarget:
     """Prepare the person's silhouette of one view (boundary, distance transform, moments).
 

@@ -28,7 +28,7 @@ import warp as wp
 from bodyfit.fitter.body_model import PART_NAMES, forward
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.kernels.boundary import nearest_boundary
-from bodyfit.kernels.camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
+from bodyfit.kernels.view_camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.cost import CostSettings
 from bodyfit.kernels.device import resolve_device
 from bodyfit.kernels.population import STAGES, PopulationEvaluator

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from bodyfit.kernels.alignment import align_label_maps, rigid_transform, silhouette_frame
-from bodyfit.kernels.camera import orthographic_camera
+from bodyfit.kernels.view_camera import orthographic_camera
 from bodyfit.kernels.target import boundary_mask
 
 from kernel_scenes import FRONT_WIDTH, HEIGHT, PIXELS_PER_METRE, random_bodies, render_labels

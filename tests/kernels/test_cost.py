@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from bodyfit.fitter.body_model import PART_NAMES
-from bodyfit.kernels.camera import orthographic_camera
+from bodyfit.kernels.view_camera import orthographic_camera
 from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
 from bodyfit.kernels.population import PopulationEvaluator, evaluate_population
 from bodyfit.kernels.reference import population_cost, view_terms
