@@ -44,9 +44,9 @@ _EXPORTS = {
     "ViewTarget": "target",
     "SIDE_VIEW_PARTS": "target",
     "prepare_view_target": "target",
-    "PopulationCost": "population",
-    "PopulationEvaluator": "population",
-    "evaluate_population": "population",
+    "PopulationCost": "evaluator",
+    "PopulationEvaluator": "evaluator",
+    "evaluate_population": "evaluator",
 }
 
 __all__ = list(_EXPORTS)
@@ -54,7 +54,7 @@ __all__ = list(_EXPORTS)
 if TYPE_CHECKING:
     from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES
     from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
-    from bodyfit.kernels.population import (PopulationCost, PopulationEvaluator,
+    from bodyfit.kernels.evaluator import (PopulationCost, PopulationEvaluator,
                                             evaluate_population)
     from bodyfit.kernels.raster import rasterize
     from bodyfit.kernels.skinning import ModelArrays, SkinnableModel, skin

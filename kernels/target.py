@@ -65,7 +65,7 @@ def boundary_distance(boundary: np.ndarray) -> np.ndarray:
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class ViewTarget:
-    """One view of the person, ready for :class:`bodyfit.kernels.population.PopulationEvaluator`.
+    """One view of the person, ready for :class:`bodyfit.kernels.evaluator.PopulationEvaluator`.
 
     Attributes:
         name: ``"front"`` or ``"side"``; selects the view weight of the cost settings.

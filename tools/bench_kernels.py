@@ -31,7 +31,7 @@ from bodyfit.kernels.boundary import nearest_boundary
 from bodyfit.kernels.view_camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.cost import CostSettings
 from bodyfit.kernels.device import resolve_device
-from bodyfit.kernels.population import STAGES, PopulationEvaluator
+from bodyfit.kernels.evaluator import STAGES, PopulationEvaluator
 from bodyfit.kernels.raster import rasterize
 from bodyfit.kernels.reference import population_cost
 from bodyfit.kernels.skinning import ModelArrays
