@@ -14,7 +14,7 @@ Written independently of the kernels and for clarity, not speed:
   centre-sampled like the kernels, to within 1/(2S) pixel;
 - boundaries and the person's distance transform: :mod:`bodyfit.kernels.target`;
   nearest boundary pixels: ``scipy.spatial.cKDTree``;
-- alignment: :func:`bodyfit.kernels.alignment.silhouette_frame` and ``rigid_transform``;
+- alignment: :func:`bodyfit.kernels.alignment.silhouette_moments` and ``rigid_transform``;
 - cost: Eq. 17-18 in NumPy.
 """
 
@@ -25,7 +25,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES, POSE_SIDES
-from bodyfit.kernels.alignment import rigid_transform, silhouette_frame
+from bodyfit.kernels.alignment import rigid_transform, silhouette_moments
 from bodyfit.kernels.view_camera import ViewCamera, camera_matrices
 from bodyfit.kernels.cost import MATCHING_WEIGHTS, TERM_NAMES, CostSettings
 from bodyfit.kernels.skinning import SkinnableModel
@@ -136,10 +136,10 @@ def interpolate_distance(distance: np.ndarray, points: np.ndarray) -> np.ndarray
 
 def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) -> np.ndarray:
     """(11,) float64 weighted terms (``TERM_NAMES``) of one candidate in one view, mm."""
-    frame = silhouette_frame(label_map >= 0)
-    if frame.area_px == 0:
+    moments = silhouette_moments(label_map >= 0)
+    if moments.area_px == 0:
         return np.full(len(TERM_NAMES), np.inf)
-    to_candidate = rigid_transform(frame, view.frame, settings.align_rotation)
+    to_candidate = rigid_transform(moments, view.moments, settings.align_rotation)
     to_person = np.linalg.inv(to_candidate)
     rows, cols = np.nonzero(boundary_mask(label_map >= 0))
     model_points = np.stack([cols, rows], axis=1).astype(np.float64)
@@ -161,8 +161,9 @@ def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) 
         backward_sums /= len(model_points)
     mix = MATCHING_WEIGHTS[settings.matching]
     parts = weights * (mix[0] * forward_sums + mix[1] * backward_sums)
-    top = abs((to_person[:2, :2] @ frame.top + to_person[:2, 2] - view.frame.top)[1])
-    bottom = abs((to_person[:2, :2] @ frame.bottom + to_person[:2, 2] - view.frame.bottom)[1])
+    top = abs((to_person[:2, :2] @ moments.top + to_person[:2, 2] - view.moments.top)[1])
+    bottom = abs((to_person[:2, :2] @ moments.bottom + to_person[:2, 2]
+                  - view.moments.bottom)[1])
     extremes = [settings.top_weight * top, settings.bottom_weight * bottom]
     scale = settings.view_weight(view.name) * view.millimetres_per_pixel
     return scale * np.concatenate([parts, extremes])

@@ -2,8 +2,9 @@
 
 Per view, once: the boundary pixels of the person's mask (the points z_i of the paper's
 Eq. 15 and 18), the exact Euclidean distance transform of that boundary (for the
-model -> person matching direction), and the silhouette's moments and top/bottom points
-(for the alignment and the paper's highest- and lowest-point terms). Host-side NumPy,
+model -> person matching direction), and the silhouette's moments
+(:class:`bodyfit.kernels.alignment.SilhouetteMoments`: centroid, orientation, top and bottom
+points, for the alignment and the paper's highest- and lowest-point terms). Host-side NumPy,
 OpenCV and SciPy; the results go to the device once.
 """
 
@@ -17,7 +18,7 @@ import scipy.ndimage as ndi
 import warp as wp
 
 from bodyfit.kernels.body_layout import PART_NAMES
-from bodyfit.kernels.alignment import SilhouetteFrame, TargetFrame, silhouette_frame
+from bodyfit.kernels.alignment import SilhouetteMoments, silhouette_moments
 from bodyfit.kernels.view_camera import ViewCamera
 from bodyfit.kernels.device import resolve_device
 
@@ -77,7 +78,7 @@ class ViewTarget:
             against the body).
         boundary_points: (N,) vec2 Warp array, the person's boundary pixels (column, row).
         boundary_distance: (H, W) float32 Warp array, pixels, exact EDT of that boundary.
-        frame: the person's centroid, orientation and top/bottom points.
+        moments: the person's silhouette moments (centroid, orientation, top/bottom points).
         silhouette: (H, W) bool, the person's mask (host copy, for references and overlays).
     """
 
@@ -89,12 +90,8 @@ class ViewTarget:
     visible_parts: tuple[str, ...]
     boundary_points: wp.array
     boundary_distance: wp.array
-    frame: SilhouetteFrame
+    moments: SilhouetteMoments
     silhouette: np.ndarray
-
-    @property
-    def target_frame(self) -> TargetFrame:
-        return self.frame.to_warp()
 
 
 def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pixel: float,
@@ -142,5 +139,5 @@ def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pix
         visible_parts=tuple(p for p in PART_NAMES if p in visible_parts),
         boundary_points=wp.array(points, dtype=wp.vec2, device=dev),
         boundary_distance=wp.array(boundary_distance(boundary), dtype=wp.float32, device=dev),
-        frame=silhouette_frame(mask),
+        moments=silhouette_moments(mask),
         silhouette=mask)
