@@ -27,6 +27,7 @@ import numpy as np
 
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import write_atomic
+from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES, POSE_SIDES  # re-exported
 
 __all__ = [
     "PART_NAMES",
@@ -38,20 +39,6 @@ __all__ = [
     "rest_shape",
     "project_shape",
 ]
-
-#: The nine body parts of the paper's Table 2, in label order (label = index).
-PART_NAMES = ("head", "chest", "waist", "hip", "leg", "foot", "arm", "elbow", "hand")
-
-#: The paper's 4 pose DOF: abduction in the frontal plane, positive = limb moves away
-#: from the body's midline. Order of the ``pose`` columns and of the rig chains/joints.
-POSE_NAMES = (
-    "shoulder_abduction_left",
-    "shoulder_abduction_right",
-    "hip_abduction_left",
-    "hip_abduction_right",
-)
-#: +1 for chains on the body's left (+x), -1 on the right: abduction turns them opposite ways.
-POSE_SIDES = np.array([1.0, -1.0, 1.0, -1.0])
 
 #: Bumped whenever the file layout or the build changes meaning; older caches are rebuilt.
 FORMAT_VERSION = 1

@@ -1,7 +1,8 @@
 """The paper's contour registration on the CPU (Section 3.3, Eq. 13-16), for overlays.
 
 The fitter scores candidates with the kernels (:mod:`bodyfit.kernels`), which align each
-candidate by silhouette moments. This module keeps the paper's own path for the final
+candidate by silhouette moments (:class:`bodyfit.kernels.alignment.SilhouetteMoments`:
+centroid and principal axis). This module keeps the paper's own path for the final
 body, to draw its matched contours: trace both boundaries, normalise them, register the
 person's contour onto the model's by 2D rigid ICP (nearest neighbours from a KD-tree,
 then the closed-form rotation and translation, repeated), and pair every person point

@@ -7,7 +7,7 @@ Steps (DESIGN.md, "The body model"):
 2. part labels and measurement landmarks on a neutral template body
    (:mod:`bodyfit.fitter.parts`);
 3. a seeded population of adults, half men and half women, whose measurements follow
-   ANSUR II's (:mod:`bodyfit.fitter.population`);
+   ANSUR II's (:mod:`bodyfit.fitter.population_sampler`);
 4. PCA over each body's rest vertices and rig joints stacked into one vector, so the
    joints are linear in the shape coefficients too (``x = mean + A @ beta``).
 """
@@ -25,7 +25,7 @@ from bodyfit.fitter import parts
 from bodyfit.fitter.anny_source import SHAPE_PARAMETERS, AnnySource
 from bodyfit.fitter.body_model import BodyModel
 from bodyfit.fitter.measurements import Measurer
-from bodyfit.fitter.population import SEXES, PopulationSampler, PopulationSettings
+from bodyfit.fitter.population_sampler import SEXES, PopulationSampler, PopulationSettings
 
 __all__ = ["ModelBuildSettings", "build_model", "template_body", "principal_components"]
 

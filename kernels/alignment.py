@@ -4,7 +4,7 @@ The paper normalises both contours and registers them rigidly (rotation + transl
 ICP with a KD-tree; Section 3.3, Eq. 13-16). Here the scale is already shared: the
 person's image is scaled from the known stature and candidates are rendered at that
 scale, so a candidate's height error stays visible to the cost. What is left, the rigid
-transform, comes in closed form from the silhouettes' first and second moments:
+transform, comes in closed form from the two silhouettes' moments (:class:`SilhouetteMoments`):
 
     translation: the person's centroid goes to the candidate's centroid;
     rotation:    the person's principal axis turns onto the candidate's principal axis.
@@ -30,9 +30,9 @@ from bodyfit.kernels.boundary import scan_label_maps
 from bodyfit.kernels.device import resolve_device
 
 __all__ = [
-    "TargetFrame",
-    "SilhouetteFrame",
-    "silhouette_frame",
+    "SilhouetteMoments",
+    "WarpSilhouetteMoments",
+    "silhouette_moments",
     "rigid_transform",
     "launch_alignment",
     "align_label_maps",
@@ -40,8 +40,9 @@ __all__ = [
 
 
 @wp.struct
-class TargetFrame:
-    """The person's silhouette in one view, what every candidate is aligned to.
+class WarpSilhouetteMoments:
+    """:class:`SilhouetteMoments` as a Warp struct, for the kernels (float32, no area): the
+    person's, which every candidate of a view is aligned to.
 
     Attributes:
         centroid: pixels (column, row).
@@ -58,13 +59,19 @@ class TargetFrame:
 
 
 @dataclasses.dataclass(frozen=True)
-class SilhouetteFrame:
-    """Moments and extreme points of a silhouette (host side, float64).
+class SilhouetteMoments:
+    """A silhouette's moments: what aligns a candidate to the person (host side, float64).
+
+    bodyfit's one name for this summary of a silhouette: its area (zeroth moment),
+    centroid (first moments) and principal-axis orientation (second central moments),
+    plus its top and bottom points (for the alignment check and the cost's highest- and
+    lowest-point terms). :func:`silhouette_moments` computes it from a mask; the kernels
+    compute the candidates' from the row scan's ``row_moments``.
 
     Attributes:
         area_px: number of silhouette pixels (0: empty, the rest is meaningless).
         centroid: (2,) pixels (column, row).
-        orientation2: radians, see :class:`TargetFrame`.
+        orientation2: radians, see :class:`WarpSilhouetteMoments`.
         top, bottom: (2,) pixels (column, row).
     """
 
@@ -74,32 +81,32 @@ class SilhouetteFrame:
     top: np.ndarray
     bottom: np.ndarray
 
-    def to_warp(self) -> TargetFrame:
-        frame = TargetFrame()
-        frame.centroid = wp.vec2(*self.centroid)
-        frame.orientation2 = float(self.orientation2)
-        frame.top = wp.vec2(*self.top)
-        frame.bottom = wp.vec2(*self.bottom)
-        return frame
+    def to_warp(self) -> WarpSilhouetteMoments:
+        moments = WarpSilhouetteMoments()
+        moments.centroid = wp.vec2(*self.centroid)
+        moments.orientation2 = float(self.orientation2)
+        moments.top = wp.vec2(*self.top)
+        moments.bottom = wp.vec2(*self.bottom)
+        return moments
 
 
-def silhouette_frame(mask: np.ndarray) -> SilhouetteFrame:
+def silhouette_moments(mask: np.ndarray) -> SilhouetteMoments:
     """Centroid, principal-axis orientation and top/bottom points of a (H, W) bool mask."""
     mask = np.asarray(mask, dtype=bool)
     rows, cols = np.nonzero(mask)
     if rows.size == 0:
         zero = np.zeros(2)
-        return SilhouetteFrame(0.0, zero, 0.0, zero, zero)
+        return SilhouetteMoments(0.0, zero, 0.0, zero, zero)
     x, y = cols.astype(np.float64), rows.astype(np.float64)
     cx, cy = x.mean(), y.mean()
     mu20, mu02, mu11 = ((x - cx) ** 2).sum(), ((y - cy) ** 2).sum(), ((x - cx) * (y - cy)).sum()
     top, bottom = rows.min(), rows.max()
-    return SilhouetteFrame(
+    return SilhouetteMoments(
         float(rows.size), np.array([cx, cy]), float(np.arctan2(2 * mu11, mu20 - mu02)),
         np.array([x[rows == top].mean(), top]), np.array([x[rows == bottom].mean(), bottom]))
 
 
-def rigid_transform(candidate: SilhouetteFrame, target: SilhouetteFrame,
+def rigid_transform(candidate: SilhouetteMoments, target: SilhouetteMoments,
                     align_rotation: bool) -> np.ndarray:
     """(3, 3) float64 homogeneous transform from person pixels to candidate pixels."""
     delta = 0.0
@@ -114,7 +121,7 @@ def rigid_transform(candidate: SilhouetteFrame, target: SilhouetteFrame,
 
 
 @wp.kernel(enable_backward=False)
-def _align_kernel(row_moments: wp.array2d(dtype=wp.vec3d), target: TargetFrame,
+def _align_kernel(row_moments: wp.array2d(dtype=wp.vec3d), target: WarpSilhouetteMoments,
                   align_rotation: int, transforms: wp.array(dtype=wp.mat33),
                   extremes: wp.array2d(dtype=wp.vec2), areas: wp.array(dtype=wp.float32)):
     p = wp.tid()
@@ -164,13 +171,13 @@ def _align_kernel(row_moments: wp.array2d(dtype=wp.vec3d), target: TargetFrame,
     transforms[p] = wp.mat33(cs, -sn, tx, sn, cs, ty, 0.0, 0.0, 1.0)
 
 
-def launch_alignment(row_moments: wp.array, target: TargetFrame, align_rotation: bool,
+def launch_alignment(row_moments: wp.array, target: WarpSilhouetteMoments, align_rotation: bool,
                      transforms: wp.array, extremes: wp.array, areas: wp.array) -> None:
     """Align every candidate to the person (no checks, no allocation).
 
     Args:
         row_moments: (P, H) vec3d from the row scan (:mod:`bodyfit.kernels.boundary`).
-        target: the person's frame in this view.
+        target: the person's silhouette moments in this view.
         align_rotation: also rotate (else translate only).
         transforms: (P,) mat33 output, person pixels -> candidate pixels.
         extremes: (P, 2) vec2 output, the candidate's top and bottom points, its pixels.
@@ -181,13 +188,13 @@ def launch_alignment(row_moments: wp.array, target: TargetFrame, align_rotation:
               outputs=[transforms, extremes, areas])
 
 
-def align_label_maps(label_maps, target: SilhouetteFrame, align_rotation: bool = True,
+def align_label_maps(label_maps, target: SilhouetteMoments, align_rotation: bool = True,
                      device: str = "cpu") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Align candidates' label maps to the person's silhouette.
 
     Args:
         label_maps: (P, H, W) int, part labels, -1 for background.
-        target: the person's :func:`silhouette_frame`.
+        target: the person's :func:`silhouette_moments`.
         align_rotation: also rotate (else translate only).
         device: where to compute.
 

@@ -29,8 +29,8 @@ import dataclasses
 
 import warp as wp
 
-from bodyfit.fitter.body_model import PART_NAMES
-from bodyfit.kernels.alignment import TargetFrame
+from bodyfit.kernels.body_layout import PART_NAMES
+from bodyfit.kernels.alignment import WarpSilhouetteMoments
 from bodyfit.kernels.boundary import run_end, run_part, run_start, transform_point
 
 __all__ = [
@@ -168,7 +168,7 @@ def _model_to_person_kernel(runs: wp.array3d(dtype=wp.int32),
 
 
 @wp.kernel(enable_backward=False)
-def _view_cost_kernel(params: CostParams, target: TargetFrame,
+def _view_cost_kernel(params: CostParams, target: WarpSilhouetteMoments,
                       distances: wp.array2d(dtype=wp.float32), parts: wp.array2d(dtype=wp.int32),
                       row_sums: wp.array2d(dtype=PartVector),
                       row_pixels: wp.array2d(dtype=wp.int32),
@@ -220,7 +220,7 @@ def launch_model_to_person(runs: wp.array, run_counts: wp.array, transforms: wp.
               outputs=[row_sums, row_pixels])
 
 
-def launch_view_cost(params: CostParams, target: TargetFrame, distances: wp.array,
+def launch_view_cost(params: CostParams, target: WarpSilhouetteMoments, distances: wp.array,
                      parts: wp.array, row_sums: wp.array, row_pixels: wp.array,
                      transforms: wp.array, extremes: wp.array, areas: wp.array,
                      term_costs: wp.array, costs: wp.array) -> None:

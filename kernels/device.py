@@ -9,8 +9,6 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from bodyfit.calib.errors import UserError
-
 __all__ = ["resolve_device", "device_array"]
 
 # numpy dtype kinds accepted for each kind of argument ('f' float, 'i'/'u' integer, 'b' bool)
@@ -21,14 +19,15 @@ def resolve_device(device: str | wp.Device) -> wp.Device:
     """The Warp device called ``device``: ``"cpu"``, ``"cuda"`` (the default GPU) or ``"cuda:N"``.
 
     Raises:
-        UserError: this machine has no such device (no NVIDIA GPU or driver, wrong index).
+        ValueError: this machine has no such device (no NVIDIA GPU or driver, wrong index);
+            the message is written for the user (a CLI prints it as its one-line error).
     """
     if isinstance(device, wp.Device):
         return device
     name = str(device)
     available = [d.alias for d in wp.get_devices()]
     if name not in available and not (name == "cuda" and wp.is_cuda_available()):
-        raise UserError(
+        raise ValueError(
             f"device {name!r} is not available here (Warp sees: {', '.join(available)}); "
             "use --device cpu, or run on a machine with an NVIDIA GPU and driver")
     return wp.get_device(name)

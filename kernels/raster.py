@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from bodyfit.kernels.camera import Camera, project_point
+from bodyfit.kernels.view_camera import ViewCamera, project_point
 from bodyfit.kernels.device import device_array, resolve_device
 
 __all__ = [
@@ -56,7 +56,7 @@ _CPU_FACES_PER_THREAD = 64
 
 
 @wp.kernel(enable_backward=False)
-def _project_kernel(cam: Camera, vertices: wp.array2d(dtype=wp.vec3),
+def _project_kernel(cam: ViewCamera, vertices: wp.array2d(dtype=wp.vec3),
                     screen: wp.array2d(dtype=wp.vec3)):
     p, v = wp.tid()
     screen[p, v] = project_point(cam, vertices[p, v])
@@ -82,7 +82,7 @@ def _span_bound(slope: float, offset: float, lo: float, hi: float):
 
 
 @wp.kernel(enable_backward=False)
-def _raster_kernel(cam: Camera, screen: wp.array2d(dtype=wp.vec3),
+def _raster_kernel(cam: ViewCamera, screen: wp.array2d(dtype=wp.vec3),
                    faces: wp.array(dtype=wp.vec3i), face_parts: wp.array(dtype=wp.int32),
                    faces_per_thread: int, keys: wp.array3d(dtype=wp.int32)):
     p, block = wp.tid()
@@ -97,7 +97,7 @@ def _raster_kernel(cam: Camera, screen: wp.array2d(dtype=wp.vec3),
         e2x = c[0] - a[0]
         e2y = c[1] - a[1]
         # Twice the signed area in (column, row) coordinates: negative when the triangle,
-        # counter-clockwise seen from outside, faces the camera (see camera.py for the frame).
+        # counter-clockwise seen from outside, faces the camera (see view_camera.py for the frame).
         area = e1x * e2y - e1y * e2x
         if area >= 0.0:
             continue
@@ -169,13 +169,13 @@ def _decode_kernel(keys: wp.array3d(dtype=wp.int32), labels: wp.array3d(dtype=wp
         labels[p, y, x] = wp.int8(key & _PART_MASK)
 
 
-def launch_projection(cam: Camera, vertices: wp.array, screen: wp.array) -> None:
+def launch_projection(cam: ViewCamera, vertices: wp.array, screen: wp.array) -> None:
     """Project checked (P, V) vec3 vertices into (P, V) vec3 ``screen`` = (u, v, q)."""
     wp.launch(_project_kernel, dim=vertices.shape, device=vertices.device,
               inputs=[cam, vertices], outputs=[screen])
 
 
-def launch_raster(cam: Camera, screen: wp.array, faces: wp.array, face_parts: wp.array,
+def launch_raster(cam: ViewCamera, screen: wp.array, faces: wp.array, face_parts: wp.array,
                   keys: wp.array) -> None:
     """Clear (P, H, W) int32 ``keys`` to ``BACKGROUND`` and rasterise into them (no checks)."""
     keys.fill_(BACKGROUND)
@@ -193,7 +193,7 @@ def decode_labels(keys: wp.array) -> wp.array:
     return labels
 
 
-def project(vertices, camera: Camera, device: str = "cpu") -> wp.array:
+def project(vertices, camera: ViewCamera, device: str = "cpu") -> wp.array:
     """Pixel coordinates and depth values of every vertex of a population.
 
     Args:
@@ -212,7 +212,7 @@ def project(vertices, camera: Camera, device: str = "cpu") -> wp.array:
     return screen
 
 
-def rasterize(vertices, faces, face_parts, camera: Camera, height: int, width: int,
+def rasterize(vertices, faces, face_parts, camera: ViewCamera, height: int, width: int,
               device: str = "cpu") -> wp.array:
     """Part-label maps of a population seen by one camera, front-most part winning.
 

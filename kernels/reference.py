@@ -2,7 +2,9 @@
 
 Written independently of the kernels and for clarity, not speed:
 
-- skinning: :func:`bodyfit.fitter.body_model.forward`;
+- skinning: :func:`skin_reference`, the paper's Eq. 1-3 in float64 NumPy, one rotation
+  matrix per chain (the body model's own NumPy forward,
+  :func:`bodyfit.fitter.body_model.forward`, is the same maths; the tests check both);
 - projection: the camera equations in float64;
 - rasterisation: ``cv2.fillPoly`` of every projected triangle (no back-face culling),
   painted far to near by mean depth (the painter's algorithm). ``cv2.fillPoly`` also draws
@@ -12,7 +14,7 @@ Written independently of the kernels and for clarity, not speed:
   centre-sampled like the kernels, to within 1/(2S) pixel;
 - boundaries and the person's distance transform: :mod:`bodyfit.kernels.target`;
   nearest boundary pixels: ``scipy.spatial.cKDTree``;
-- alignment: :func:`bodyfit.kernels.alignment.silhouette_frame` and ``rigid_transform``;
+- alignment: :func:`bodyfit.kernels.alignment.silhouette_moments` and ``rigid_transform``;
 - cost: Eq. 17-18 in NumPy.
 """
 
@@ -22,24 +24,54 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from bodyfit.fitter.body_model import PART_NAMES, BodyModel, forward
-from bodyfit.kernels.alignment import rigid_transform, silhouette_frame
-from bodyfit.kernels.camera import Camera, camera_matrices
+from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES, POSE_SIDES
+from bodyfit.kernels.alignment import rigid_transform, silhouette_moments
+from bodyfit.kernels.view_camera import ViewCamera, camera_matrices
 from bodyfit.kernels.cost import MATCHING_WEIGHTS, TERM_NAMES, CostSettings
+from bodyfit.kernels.skinning import SkinnableModel
 from bodyfit.kernels.target import ViewTarget, boundary_mask, visible_faces
 
-__all__ = ["project_vertices", "render_label_maps", "interpolate_distance", "view_terms",
-           "population_cost"]
+__all__ = ["skin_reference", "project_vertices", "render_label_maps", "interpolate_distance",
+           "view_terms", "population_cost"]
 
 _SHIFT = 8  # fixed-point bits of the cv2.fillPoly coordinates
 _BAND_PIXELS = 1 << 20  # fine-grid pixels painted per band
 
 
-def project_vertices(camera: Camera, vertices: np.ndarray) -> np.ndarray:
+def skin_reference(model: SkinnableModel, betas, pose_deg) -> np.ndarray:
+    """(P, V, 3) float64 posed vertices, metres, model frame: shape blend, then LBS.
+
+    Args:
+        model: a body model (the attributes of :class:`bodyfit.kernels.skinning.SkinnableModel`).
+        betas: (P, K) float, shape coefficients in units of standard deviation.
+        pose_deg: (P, 4) float, abduction angles in degrees, ``POSE_NAMES`` order.
+    """
+    betas = np.asarray(betas, dtype=np.float64)
+    pose_deg = np.asarray(pose_deg, dtype=np.float64)
+    if betas.ndim != 2 or pose_deg.shape != (len(betas), len(POSE_NAMES)):
+        raise ValueError(f"betas must be (P, K) and pose_deg (P, 4); got {betas.shape} "
+                         f"and {pose_deg.shape}")
+    vertex_dirs, joint_dirs = model.shape_directions(betas.shape[1])
+    rest = model.mean_vertices + np.einsum("pk,kvd->pvd", betas, vertex_dirs)
+    joints = model.mean_joints + np.einsum("pk,kcd->pcd", betas, joint_dirs)
+    posed = rest.copy()
+    for c in range(len(POSE_NAMES)):
+        theta = np.deg2rad(pose_deg[:, c]) * POSE_SIDES[c]  # about the y axis, x-z plane
+        cos, sin = np.cos(theta), np.sin(theta)
+        rotation = np.zeros((len(betas), 3, 3))
+        rotation[:, 0, 0], rotation[:, 0, 2], rotation[:, 1, 1] = cos, -sin, 1.0
+        rotation[:, 2, 0], rotation[:, 2, 2] = sin, cos
+        joint = joints[:, c, None, :]
+        moved = np.einsum("pij,pvj->pvi", rotation, rest - joint) + joint
+        posed += model.chain_weights[None, :, c, None] * (moved - rest)
+    return posed
+
+
+def project_vertices(camera: ViewCamera, vertices: np.ndarray) -> np.ndarray:
     """(..., 3) float64 (u, v, z_cam): pixels (column, row) and depth in metres.
 
     Args:
-        camera: a camera of :mod:`bodyfit.kernels.camera`.
+        camera: a camera of :mod:`bodyfit.kernels.view_camera`.
         vertices: (..., 3) float, metres, model frame.
     """
     k, r, t = camera_matrices(camera)
@@ -104,10 +136,10 @@ def interpolate_distance(distance: np.ndarray, points: np.ndarray) -> np.ndarray
 
 def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) -> np.ndarray:
     """(11,) float64 weighted terms (``TERM_NAMES``) of one candidate in one view, mm."""
-    frame = silhouette_frame(label_map >= 0)
-    if frame.area_px == 0:
+    moments = silhouette_moments(label_map >= 0)
+    if moments.area_px == 0:
         return np.full(len(TERM_NAMES), np.inf)
-    to_candidate = rigid_transform(frame, view.frame, settings.align_rotation)
+    to_candidate = rigid_transform(moments, view.moments, settings.align_rotation)
     to_person = np.linalg.inv(to_candidate)
     rows, cols = np.nonzero(boundary_mask(label_map >= 0))
     model_points = np.stack([cols, rows], axis=1).astype(np.float64)
@@ -129,18 +161,19 @@ def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) 
         backward_sums /= len(model_points)
     mix = MATCHING_WEIGHTS[settings.matching]
     parts = weights * (mix[0] * forward_sums + mix[1] * backward_sums)
-    top = abs((to_person[:2, :2] @ frame.top + to_person[:2, 2] - view.frame.top)[1])
-    bottom = abs((to_person[:2, :2] @ frame.bottom + to_person[:2, 2] - view.frame.bottom)[1])
+    top = abs((to_person[:2, :2] @ moments.top + to_person[:2, 2] - view.moments.top)[1])
+    bottom = abs((to_person[:2, :2] @ moments.bottom + to_person[:2, 2]
+                  - view.moments.bottom)[1])
     extremes = [settings.top_weight * top, settings.bottom_weight * bottom]
     scale = settings.view_weight(view.name) * view.millimetres_per_pixel
     return scale * np.concatenate([parts, extremes])
 
 
-def population_cost(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
+def population_cost(model: SkinnableModel, betas: np.ndarray, pose_deg: np.ndarray,
                     views: list[ViewTarget], settings: CostSettings = CostSettings(),
                     supersample: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """The reference pipeline: costs (P,) and part costs (P, 11), float64, millimetres."""
-    vertices = forward(model, betas, pose_deg)
+    vertices = skin_reference(model, betas, pose_deg)
     part_costs = np.zeros((len(betas), len(TERM_NAMES)))
     for view in views:
         faces, face_parts = visible_faces(model.faces, model.face_parts, view.visible_parts)

@@ -1,6 +1,7 @@
 """The body model on a device, and skinning: (P, K) betas + (P, 4) pose -> (P, V, 3) vertices.
 
-The same maths as :func:`bodyfit.fitter.body_model.forward` (the paper's Eq. 1-3):
+The same maths as the body model's NumPy forward (:func:`bodyfit.fitter.body_model.forward`,
+and :func:`bodyfit.kernels.reference.skin_reference`; the paper's Eq. 1-3):
 
     rest_i  = mean_i + sum_k betas[k] * vertex_dirs[k, i]                 (shape blend)
     joint_c = mean_joint_c + sum_k betas[k] * joint_dirs[k, c]
@@ -14,16 +15,46 @@ One thread per (candidate, chain) computes the joints and rotations, then one th
 from __future__ import annotations
 
 import dataclasses
+from typing import Protocol
 
 import numpy as np
 import warp as wp
 
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, POSE_SIDES, BodyModel
+from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES, POSE_SIDES
 from bodyfit.kernels.device import device_array, resolve_device
 
-__all__ = ["ShapeSpace", "ModelArrays", "skin", "launch_skinning"]
+__all__ = ["SkinnableModel", "ShapeSpace", "ModelArrays", "skin", "launch_skinning"]
 
 NUM_CHAINS = len(POSE_NAMES)
+
+
+class SkinnableModel(Protocol):
+    """What the kernels read from a body model (duck-typed; the kernels import no model).
+
+    :class:`bodyfit.fitter.body_model.BodyModel` is one. V vertices, F faces, C stored
+    shape components, 4 rig chains (``POSE_NAMES`` order).
+
+    Attributes:
+        mean_vertices: (V, 3) float, metres, model frame; rest (A-pose) mean body.
+        mean_joints: (4, 3) float, metres; rig joints of the mean body.
+        chain_weights: (V, 4) float in [0, 1]; skinning weight of each vertex per chain.
+        faces: (F, 3) int triangles, counter-clockwise seen from outside.
+        face_parts: (F,) int8 index into ``PART_NAMES``.
+        num_vertices: V.
+        num_components: C.
+    """
+
+    mean_vertices: np.ndarray
+    mean_joints: np.ndarray
+    chain_weights: np.ndarray
+    faces: np.ndarray
+    face_parts: np.ndarray
+    num_vertices: int
+    num_components: int
+
+    def shape_directions(self, num_betas: int) -> tuple[np.ndarray, np.ndarray]:
+        """(K, V, 3) vertex and (K, 4, 3) joint directions scaled by their standard
+        deviation (metres per sigma), K = ``num_betas`` <= C."""
 
 
 @wp.struct
@@ -99,7 +130,7 @@ def _skin_kernel(space: ShapeSpace, betas: wp.array2d(dtype=wp.float32),
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class ModelArrays:
-    """A :class:`BodyModel` prepared for the kernels on one device, with K betas.
+    """A body model (:class:`SkinnableModel`) prepared for the kernels on one device, with K betas.
 
     Attributes:
         space: the shape space and rig (see :class:`ShapeSpace`).
@@ -118,14 +149,23 @@ class ModelArrays:
     device: wp.Device
 
     @classmethod
-    def from_body_model(cls, model: BodyModel, num_betas: int = 20,
+    def from_body_model(cls, model: SkinnableModel, num_betas: int = 20,
                         device: str = "cpu") -> "ModelArrays":
         """Copy the model's first ``num_betas`` shape directions and its rig to ``device``.
 
+        Args:
+            model: any object with the attributes of :class:`SkinnableModel` (a
+                :class:`bodyfit.fitter.body_model.BodyModel`).
+
         Raises:
-            UserError: the model stores fewer components, or the device is unavailable.
+            ValueError: the model stores fewer than ``num_betas`` components, its part
+                labels exceed ``PART_NAMES``, or the device is unavailable.
         """
         dev = resolve_device(device)
+        if not 1 <= num_betas <= model.num_components:
+            raise ValueError(
+                f"the body model stores {model.num_components} shape components; "
+                f"asked for {num_betas}. Rebuild it with `fitter model build --components N`.")
         vertex_dirs, joint_dirs = model.shape_directions(num_betas)
         space = ShapeSpace()
         space.mean_vertices = wp.array(model.mean_vertices, dtype=wp.vec3, device=dev)

@@ -2,8 +2,9 @@
 
 Per view, once: the boundary pixels of the person's mask (the points z_i of the paper's
 Eq. 15 and 18), the exact Euclidean distance transform of that boundary (for the
-model -> person matching direction), and the silhouette's moments and top/bottom points
-(for the alignment and the paper's highest- and lowest-point terms). Host-side NumPy,
+model -> person matching direction), and the silhouette's moments
+(:class:`bodyfit.kernels.alignment.SilhouetteMoments`: centroid, orientation, top and bottom
+points, for the alignment and the paper's highest- and lowest-point terms). Host-side NumPy,
 OpenCV and SciPy; the results go to the device once.
 """
 
@@ -16,9 +17,9 @@ import numpy as np
 import scipy.ndimage as ndi
 import warp as wp
 
-from bodyfit.fitter.body_model import PART_NAMES
-from bodyfit.kernels.alignment import SilhouetteFrame, TargetFrame, silhouette_frame
-from bodyfit.kernels.camera import Camera
+from bodyfit.kernels.body_layout import PART_NAMES
+from bodyfit.kernels.alignment import SilhouetteMoments, silhouette_moments
+from bodyfit.kernels.view_camera import ViewCamera
 from bodyfit.kernels.device import resolve_device
 
 __all__ = ["VIEW_NAMES", "SIDE_VIEW_PARTS", "ViewTarget", "prepare_view_target",
@@ -65,7 +66,7 @@ def boundary_distance(boundary: np.ndarray) -> np.ndarray:
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class ViewTarget:
-    """One view of the person, ready for :class:`bodyfit.kernels.population.PopulationEvaluator`.
+    """One view of the person, ready for :class:`bodyfit.kernels.evaluator.PopulationEvaluator`.
 
     Attributes:
         name: ``"front"`` or ``"side"``; selects the view weight of the cost settings.
@@ -77,27 +78,23 @@ class ViewTarget:
             against the body).
         boundary_points: (N,) vec2 Warp array, the person's boundary pixels (column, row).
         boundary_distance: (H, W) float32 Warp array, pixels, exact EDT of that boundary.
-        frame: the person's centroid, orientation and top/bottom points.
+        moments: the person's silhouette moments (centroid, orientation, top/bottom points).
         silhouette: (H, W) bool, the person's mask (host copy, for references and overlays).
     """
 
     name: str
-    camera: Camera
+    camera: ViewCamera
     height: int
     width: int
     millimetres_per_pixel: float
     visible_parts: tuple[str, ...]
     boundary_points: wp.array
     boundary_distance: wp.array
-    frame: SilhouetteFrame
+    moments: SilhouetteMoments
     silhouette: np.ndarray
 
-    @property
-    def target_frame(self) -> TargetFrame:
-        return self.frame.to_warp()
 
-
-def prepare_view_target(name: str, mask, camera: Camera, millimetres_per_pixel: float,
+def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pixel: float,
                         visible_parts=PART_NAMES, device: str = "cpu") -> ViewTarget:
     """Prepare the person's silhouette of one view (boundary, distance transform, moments).
 
@@ -142,5 +139,5 @@ def prepare_view_target(name: str, mask, camera: Camera, millimetres_per_pixel: 
         visible_parts=tuple(p for p in PART_NAMES if p in visible_parts),
         boundary_points=wp.array(points, dtype=wp.vec2, device=dev),
         boundary_distance=wp.array(boundary_distance(boundary), dtype=wp.float32, device=dev),
-        frame=silhouette_frame(mask),
+        moments=silhouette_moments(mask),
         silhouette=mask)

@@ -18,6 +18,7 @@ import argparse
 import os
 import platform
 import resource
+import sys
 import time
 
 import numpy as np
@@ -27,9 +28,10 @@ import warp as wp
 from bodyfit.fitter.body_model import PART_NAMES, forward
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.kernels.boundary import nearest_boundary
-from bodyfit.kernels.camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
+from bodyfit.kernels.view_camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.cost import CostSettings
-from bodyfit.kernels.population import STAGES, PopulationEvaluator
+from bodyfit.kernels.device import resolve_device
+from bodyfit.kernels.evaluator import STAGES, PopulationEvaluator
 from bodyfit.kernels.raster import rasterize
 from bodyfit.kernels.reference import population_cost
 from bodyfit.kernels.skinning import ModelArrays
@@ -107,8 +109,11 @@ def main() -> None:
 
     wp.config.log_level = wp.LOG_WARNING  # keep Warp's start-up and module lines out
     model = load_model()
-    device = wp.get_device(args.device)
-    arrays = ModelArrays.from_body_model(model, 20, device)
+    try:  # the kernels raise ValueError, with a message for the user, for a bad device
+        device = resolve_device(args.device)
+        arrays = ModelArrays.from_body_model(model, 20, device)
+    except ValueError as exc:
+        sys.exit(f"bench_kernels: error: {exc}")
     views, person = _views(model, args.height, device, args.seed)
     settings = CostSettings()
     num_views = len(views)
@@ -163,7 +168,7 @@ def main() -> None:
     agreement = np.median(np.abs(kernel_costs - reference_costs) / reference_costs)
     largest = max(args.populations)
     ratio = totals[largest] * reference_s
-    print(f"NumPy/OpenCV reference (forward, cv2.fillPoly far to near, cKDTree): "
+    print(f"NumPy/OpenCV reference (skin_reference, cv2.fillPoly far to near, cKDTree): "
           f"{1e3 * reference_s:.1f} ms per cv on {args.reference_candidates} candidates; "
           f"kernels at P = {largest}: {ratio:.0f}x faster (target >= {REFERENCE_TARGET_RATIO:.0f}x: "
           f"{'met' if ratio >= REFERENCE_TARGET_RATIO else 'missed'}). Median cost difference "

@@ -30,7 +30,7 @@ from bodyfit.fitter.model_cache import active_model_path, load_model
 from bodyfit.calib.images import write_image
 from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.model_build import ModelBuildSettings
-from bodyfit.fitter.population import SEXES, PopulationSampler, ReferenceStats
+from bodyfit.fitter.population_sampler import SEXES, PopulationSampler, ReferenceStats
 from bodyfit.fitter.render import parts_legend, render_parts
 
 KEYS = list(MEASUREMENTS)

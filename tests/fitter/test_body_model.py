@@ -10,7 +10,7 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter import model_cache
 from bodyfit.fitter.body_model import BodyModel, project_shape, rest_shape
 from bodyfit.fitter.model_build import ModelBuildSettings
-from bodyfit.fitter.population import PopulationSampler
+from bodyfit.fitter.population_sampler import PopulationSampler
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "model.md"
 
@@ -130,7 +130,7 @@ def test_pickled_file_error_gives_no_pickle_advice(tmp_path):
 def test_small_build_saves_and_loads(tmp_path, monkeypatch):
     """The build end to end on a small population (the full one takes minutes): the
     user-built model in the cache then takes the shipped one's place."""
-    from bodyfit.fitter.population import PopulationSettings
+    from bodyfit.fitter.population_sampler import PopulationSettings
 
     monkeypatch.setenv(model_cache.CACHE_ENV_VAR, str(tmp_path))
     settings = ModelBuildSettings(components=6, samples=100, seed=3,

@@ -7,7 +7,7 @@ from scipy.spatial import ConvexHull
 
 from bodyfit.fitter.anny_source import SHAPE_PARAMETERS
 from bodyfit.fitter.measurements import MEASUREMENTS
-from bodyfit.fitter.population import SEXES, ReferenceStats
+from bodyfit.fitter.population_sampler import SEXES, ReferenceStats
 from bodyfit.fitter.sections import mesh_edges, tape_lengths
 
 KEYS = list(MEASUREMENTS)

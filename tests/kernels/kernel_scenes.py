@@ -7,7 +7,7 @@ import pytest
 import warp as wp
 
 from bodyfit.fitter.body_model import PART_NAMES, forward
-from bodyfit.kernels.camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
+from bodyfit.kernels.view_camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.raster import rasterize
 from bodyfit.kernels.target import visible_faces
 

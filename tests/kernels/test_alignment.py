@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bodyfit.kernels.alignment import align_label_maps, rigid_transform, silhouette_frame
-from bodyfit.kernels.camera import orthographic_camera
+from bodyfit.kernels.alignment import align_label_maps, rigid_transform, silhouette_moments
+from bodyfit.kernels.view_camera import orthographic_camera
 from bodyfit.kernels.target import boundary_mask
 
 from kernel_scenes import FRONT_WIDTH, HEIGHT, PIXELS_PER_METRE, random_bodies, render_labels
@@ -40,7 +40,7 @@ def _true_map(points, roll_deg, shift):
 
 def test_alignment_recovers_a_known_rotation_and_shift(person_and_moved):
     person, moved = person_and_moved
-    target = silhouette_frame(person >= 0)
+    target = silhouette_moments(person >= 0)
     transforms, extremes, areas = align_label_maps(moved, target)
     rows, cols = np.nonzero(boundary_mask(person >= 0))
     points = np.stack([cols, rows], axis=1).astype(float)
@@ -50,18 +50,18 @@ def test_alignment_recovers_a_known_rotation_and_shift(person_and_moved):
         assert np.rad2deg(np.arctan2(transform[1, 0], transform[0, 0])) == pytest.approx(roll,
                                                                                           abs=0.1)
     for labels, ext, area in zip(moved, extremes, areas):
-        frame = silhouette_frame(labels >= 0)
-        assert area == frame.area_px
-        assert np.allclose(ext, [frame.top, frame.bottom], atol=1e-3)
+        moments = silhouette_moments(labels >= 0)
+        assert area == moments.area_px
+        assert np.allclose(ext, [moments.top, moments.bottom], atol=1e-3)
 
 
 def test_kernel_alignment_equals_numpy_reference(person_and_moved):
     person, moved = person_and_moved
-    target = silhouette_frame(person >= 0)
+    target = silhouette_moments(person >= 0)
     for rotate in (True, False):
         transforms = align_label_maps(moved, target, align_rotation=rotate)[0]
         for labels, transform in zip(moved, transforms):
-            expected = rigid_transform(silhouette_frame(labels >= 0), target, rotate)
+            expected = rigid_transform(silhouette_moments(labels >= 0), target, rotate)
             assert np.allclose(transform, expected, atol=2e-3)
     translation_only = align_label_maps(moved, target, align_rotation=False)[0]
     assert np.allclose(translation_only[:, :2, :2], np.eye(2))
@@ -70,5 +70,5 @@ def test_kernel_alignment_equals_numpy_reference(person_and_moved):
 def test_empty_silhouette_has_zero_area(person_and_moved):
     person, _ = person_and_moved
     _, _, areas = align_label_maps(np.full((1, 8, 8), -1, np.int8),
-                                   silhouette_frame(person >= 0))
+                                   silhouette_moments(person >= 0))
     assert areas[0] == 0

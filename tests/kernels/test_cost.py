@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from bodyfit.fitter.body_model import PART_NAMES
-from bodyfit.kernels.camera import orthographic_camera
+from bodyfit.kernels.view_camera import orthographic_camera
 from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
-from bodyfit.kernels.population import PopulationEvaluator, evaluate_population
+from bodyfit.kernels.evaluator import PopulationEvaluator, evaluate_population
 from bodyfit.kernels.reference import population_cost, view_terms
 from bodyfit.kernels.skinning import ModelArrays
 from bodyfit.kernels.target import SIDE_VIEW_PARTS, prepare_view_target

@@ -7,8 +7,8 @@ import pytest
 import scipy.ndimage as ndi
 
 from bodyfit.fitter.body_model import forward
-from bodyfit.kernels.camera import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera,
-                                    paper_rotation, pinhole_camera)
+from bodyfit.kernels.view_camera import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera,
+                                         paper_rotation, pinhole_camera)
 from bodyfit.kernels.raster import project, rasterize
 from bodyfit.kernels.reference import project_vertices, render_label_maps
 

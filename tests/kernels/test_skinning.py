@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import warp as wp
 
-from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import forward
 from bodyfit.kernels.device import resolve_device
+from bodyfit.kernels.reference import skin_reference
 from bodyfit.kernels.skinning import ModelArrays, skin
 
 from kernel_scenes import DEVICES, random_bodies
@@ -25,6 +25,13 @@ def test_skin_matches_numpy_forward(body_model, device):
     expected = forward(body_model, betas, pose)
     assert posed.shape == expected.shape == (6, body_model.num_vertices, 3)
     assert np.abs(posed - expected).max() < 1e-5
+
+
+def test_numpy_skin_reference_matches_the_body_models_forward(body_model):
+    betas, pose = random_bodies(4, seed=3, spread=3.0)
+    pose[0] = [30.0, -5.0, 10.0, 45.0]
+    expected = forward(body_model, betas, pose)
+    assert np.abs(skin_reference(body_model, betas, pose) - expected).max() < 1e-5
 
 
 def test_skin_moves_only_the_posed_chain(body_model, model_arrays):
@@ -61,13 +68,13 @@ def test_skin_rejects_wrong_dtypes(model_arrays):
 
 
 def test_unavailable_device_is_a_clear_error(body_model):
-    with pytest.raises(UserError, match="'tpu:0' is not available"):
+    with pytest.raises(ValueError, match="'tpu:0' is not available"):
         resolve_device("tpu:0")
     if not wp.is_cuda_available():
-        with pytest.raises(UserError, match="use --device cpu"):
+        with pytest.raises(ValueError, match="use --device cpu"):
             ModelArrays.from_body_model(body_model, device="cuda:0")
 
 
-def test_too_many_betas_is_a_user_error(body_model):
-    with pytest.raises(UserError, match="stores"):
+def test_too_many_betas_is_a_value_error(body_model):
+    with pytest.raises(ValueError, match="stores"):
         ModelArrays.from_body_model(body_model, num_betas=body_model.num_components + 1)

@@ -19,7 +19,7 @@ from typing import NamedTuple, Sequence
 import numpy as np
 import warp as wp
 
-from bodyfit.fitter.body_model import POSE_NAMES
+from bodyfit.kernels.body_layout import POSE_NAMES
 from bodyfit.kernels.alignment import launch_alignment
 from bodyfit.kernels.boundary import BoundaryRuns, allocate_runs, launch_nearest, launch_row_scan
 from bodyfit.kernels.cost import (TERM_NAMES, CostSettings, PartVector, cost_params,
@@ -64,7 +64,7 @@ class _ViewState:
         self.faces = wp.array(faces, dtype=wp.vec3i, device=dev)
         self.face_parts = wp.array(face_parts.astype(np.int32), dtype=wp.int32, device=dev)
         self.params = cost_params(settings, view.name, view.millimetres_per_pixel)
-        self.frame = view.target_frame
+        self.moments = view.moments.to_warp()
 
     def allocate(self, chunk: int) -> None:
         """(Re)allocate the buffers for chunks of up to ``chunk`` candidates."""
@@ -215,7 +215,7 @@ class PopulationEvaluator:
         distances, parts = state.distances[:num], state.parts[:num]
         row_sums, row_pixels = state.row_sums[:num], state.row_pixels[:num]
         launch_row_scan(keys, scan)
-        launch_alignment(scan.row_moments, state.frame, self.settings.align_rotation,
+        launch_alignment(scan.row_moments, state.moments, self.settings.align_rotation,
                          transforms, extremes, areas)
         if state.params.person_to_model > 0:
             launch_nearest(scan, view.boundary_points, transforms, distances, parts)
@@ -223,7 +223,7 @@ class PopulationEvaluator:
             launch_model_to_person(scan.runs, scan.run_counts, transforms, view.boundary_distance,
                                    row_sums, row_pixels)
         self._stage_done("distance")
-        launch_view_cost(state.params, state.frame, distances, parts, row_sums, row_pixels,
+        launch_view_cost(state.params, state.moments, distances, parts, row_sums, row_pixels,
                          transforms, extremes, areas, term_costs, costs)
         self._stage_done("cost")
 

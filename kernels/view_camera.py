@@ -1,6 +1,11 @@
-"""Cameras: the paper's orthographic front and side projections, and a calibrated pinhole.
+"""View cameras: the paper's orthographic front and side projections, and a calibrated pinhole.
 
-A camera maps the model frame (metres, z up, -y forward, +x the body's left) to pixels:
+A :class:`ViewCamera` is the projection every candidate of one view is rendered with, on
+the device. It is not :class:`bodyfit.calib.camera.Camera`, the calibrated phone camera
+(intrinsics, lens distortion and their uncertainties, read from camera.json); a pinhole
+``ViewCamera`` takes that camera's K once the photos are undistorted.
+
+A view camera maps the model frame (metres, z up, -y forward, +x the body's left) to pixels:
 
     x_cam = rotation @ x + translation        camera frame: x right, y down, z forward
     pinhole:      u = fx * x_cam/z_cam + skew * y_cam/z_cam + cx,   v = fy * y_cam/z_cam + cy
@@ -23,7 +28,7 @@ import numpy as np
 import warp as wp
 
 __all__ = [
-    "Camera",
+    "ViewCamera",
     "FRONT_VIEW_DEG",
     "SIDE_VIEW_DEG",
     "paper_rotation",
@@ -39,8 +44,9 @@ SIDE_VIEW_DEG = (90.0, 90.0, 0.0)
 
 
 @wp.struct
-class Camera:
-    """One view's projection, shared by every candidate (see the module docstring).
+class ViewCamera:
+    """One view's projection, shared by every candidate (see the module docstring); made by
+    :func:`orthographic_camera` or :func:`pinhole_camera`.
 
     Attributes:
         rotation: model frame -> camera frame rotation (det +1).
@@ -62,7 +68,7 @@ class Camera:
 
 
 @wp.func
-def project_point(cam: Camera, x: wp.vec3):
+def project_point(cam: ViewCamera, x: wp.vec3):
     """Pixel coordinates (u, v) and the screen-linear depth value q of a model-frame point.
 
     q is z_cam for an orthographic camera and 1/z_cam for a pinhole one: in both cases q
@@ -91,8 +97,8 @@ def paper_rotation(view_deg) -> np.ndarray:
     return rz @ ry @ rx
 
 
-def _make_camera(rotation, translation, fx, fy, cx, cy, skew, pinhole) -> Camera:
-    cam = Camera()
+def _make_camera(rotation, translation, fx, fy, cx, cy, skew, pinhole) -> ViewCamera:
+    cam = ViewCamera()
     cam.rotation = wp.mat33(*np.asarray(rotation, dtype=np.float64).ravel())
     cam.translation = wp.vec3(*np.asarray(translation, dtype=np.float64))
     cam.fx, cam.fy, cam.cx, cam.cy, cam.skew = (float(v) for v in (fx, fy, cx, cy, skew))
@@ -101,7 +107,7 @@ def _make_camera(rotation, translation, fx, fy, cx, cy, skew, pinhole) -> Camera
 
 
 def orthographic_camera(view_deg, pixels_per_metre: float, principal_point_px,
-                        distance_m: float = 10.0) -> Camera:
+                        distance_m: float = 10.0) -> ViewCamera:
     """The paper's orthographic projection (Eq. 4-12), scaled to pixels.
 
     Args:
@@ -123,7 +129,7 @@ def orthographic_camera(view_deg, pixels_per_metre: float, principal_point_px,
                         pixels_per_metre, centre[0], centre[1], 0.0, 0)
 
 
-def pinhole_camera(intrinsics, rotation, translation_m) -> Camera:
+def pinhole_camera(intrinsics, rotation, translation_m) -> ViewCamera:
     """A calibrated pinhole camera (OpenCV conventions, lens distortion already removed).
 
     Args:
@@ -150,7 +156,7 @@ def pinhole_camera(intrinsics, rotation, translation_m) -> Camera:
     return _make_camera(r, t, k[0, 0], k[1, 1], k[0, 2], k[1, 2], k[0, 1], 1)
 
 
-def camera_matrices(cam: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def camera_matrices(cam: ViewCamera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A camera's (K (3, 3), R (3, 3), t (3,)) as float64 NumPy arrays, for host code.
 
     For an orthographic camera K holds the pixels-per-metre scale and the principal point
