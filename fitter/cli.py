@@ -1,7 +1,6 @@
-"""`fitter`: the body model and its 16 measurements from the command line.
+"""`fitter`: fit the body model to a person's photos, measure meshes, build the model.
 
-Fitting the model to a person's photos (`fitter run`) is not available yet; the help
-says only what exists. User errors, usage errors included, print one line,
+The help says only what exists. User errors, usage errors included, print one line,
 ``fitter: error: ...``, and exit with status 2.
 """
 
@@ -38,9 +37,9 @@ def _version() -> str:
 def _build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="fitter",
-        description="bodyfit's statistical body model and its 16 tape measurements: draw "
-                    "bodies, measure meshes, build the model. Lengths in files are metres "
-                    "(meshes) and millimetres (measurements).")
+        description="bodyfit: a 3D body and 16 tape measurements from a front and a side "
+                    "photo (fitter run); draw and measure bodies of the model. Lengths in "
+                    "files are metres (meshes) and millimetres (measurements).")
     parser.add_argument("--version", action="version", version=f"bodyfit {_version()}")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -66,6 +65,48 @@ def _build_parser() -> argparse.ArgumentParser:
                       help="output directory (default out/demo)")
     demo.add_argument("--bodies", type=int, default=3, help="bodies to draw (default 3)")
     demo.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+
+    run = sub.add_parser(
+        "run", help="fit the body model to a person's front and side photos: mesh (m), "
+                    "16 measurements (mm), convergence plot, run record",
+        description="Fit bodyfit's body model to a front photo (A-pose) and a side photo "
+                    "(arms hanging down) on a plain backdrop. Cameras: the paper's "
+                    "orthographic projection, each view scaled from the stature.")
+    run.add_argument("--front", required=True, metavar="PHOTO", help="front photo, A-pose")
+    run.add_argument("--side", required=True, metavar="PHOTO",
+                     help="side photo (the person's left side), arms hanging down")
+    run.add_argument("--height-cm", required=True, type=float, metavar="CM",
+                     help="the person's stature, centimetres")
+    run.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
+                     help="output folder (created; must be empty unless --overwrite)")
+    run.add_argument("--camera", metavar="camera.json",
+                     help="undistort the photos with this calibration (calib capture)")
+    run.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
+                     "(white person on black, of the undistorted upright photo)")
+    run.add_argument("--mask-side", metavar="PNG", help="your own side silhouette")
+    run.add_argument("--background-front", metavar="PHOTO",
+                     help="background plate: the front view without the person")
+    run.add_argument("--background-side", metavar="PHOTO", help="background plate, side view")
+    run.add_argument("--sex", choices=("female", "male", "unknown"), default="unknown",
+                     help="recorded with the run (default unknown)")
+    run.add_argument("--weights", default="paper", metavar="PRESET|FILE.toml",
+                     help="cost weights: paper (Table 2, default), uniform, lower-body, "
+                          "or a .toml file")
+    run.add_argument("--weight", action="append", default=[], metavar="NAME=VALUE",
+                     help="override one weight, e.g. waist=8 or view.side=3 (repeatable)")
+    run.add_argument("--matching", default="person_to_model",
+                     help="boundary matching direction: person_to_model (the paper's, "
+                          "default), model_to_person or symmetric")
+    run.add_argument("--optimizer", choices=("ga", "cmaes"), default="ga",
+                     help="ga: the paper's genetic algorithm (default); cmaes: CMA-ES")
+    run.add_argument("--population", type=int, help="candidates per generation "
+                     "(default: ga 30, cmaes its own)")
+    run.add_argument("--generations", type=int, help="generations (default: ga 25)")
+    run.add_argument("--components", type=int, default=20,
+                     help="shape components searched (default 20, as the paper; up to 60)")
+    run.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    run.add_argument("--device", default="cpu", help="cpu (default) or cuda:0")
+    run.add_argument("--overwrite", action="store_true", help="write into a non-empty OUT")
 
     measure = sub.add_parser("measure", help="the 16 measurements (mm) of a mesh in the "
                                              "model's topology (.obj/.ply)")
@@ -130,6 +171,42 @@ def _cmd_demo(args) -> None:
         print(f"  {path}")
 
 
+def _cmd_run(args) -> None:
+    from bodyfit.fitter.fit import FitSettings
+    from bodyfit.fitter.measurements import MEASUREMENTS
+    from bodyfit.fitter.model_cache import load_model
+    from bodyfit.fitter.person import PersonInputs
+    from bodyfit.fitter.run import run_person
+    from bodyfit.fitter.search import SearchSettings
+    from bodyfit.fitter.weights import cost_settings
+    from bodyfit.kernels import CostSettings
+
+    inputs = PersonInputs(args.front, args.side, args.height_cm, args.camera, args.mask_front,
+                          args.mask_side, args.background_front, args.background_side, args.sex)
+    inputs.validate()
+    try:
+        settings = FitSettings(
+            search=SearchSettings(optimizer=args.optimizer, population=args.population,
+                                  generations=args.generations, components=args.components,
+                                  seed=args.seed),
+            cost=cost_settings(args.weights, args.weight, CostSettings(matching=args.matching)),
+            device=args.device)
+        model = load_model()
+        fit, written = run_person(model, inputs, settings, args.output, args.overwrite,
+                                  progress=None if not args.quiet else False)
+    except ValueError as exc:  # the kernels' argument and device errors, --matching
+        raise UserError(str(exc)) from None
+    result = fit.search
+    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {result.evaluations} candidates, "
+          f"{result.generations} generations, best cost {result.cost:.1f} weighted mm")
+    for key, (_, label) in MEASUREMENTS.items():
+        print(f"  {key} {label:<28} {fit.measurements[key]:8.1f} ± "
+              f"{fit.spreads[key]:5.1f} mm")
+    print("wrote:")
+    for path in written:
+        print(f"  {path}")
+
+
 def _cmd_measure(args) -> None:
     from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
     from bodyfit.fitter.mesh_io import read_mesh
@@ -161,7 +238,7 @@ def main(argv: list[str] | None = None) -> int:
     import warp  # Warp prints its banner and module loads at INFO; the CLI keeps to errors
 
     warp.config.log_level = warp.LOG_ERROR
-    command = {"demo": _cmd_demo, "measure": _cmd_measure}.get(args.command)
+    command = {"demo": _cmd_demo, "measure": _cmd_measure, "run": _cmd_run}.get(args.command)
     if args.command == "model":
         command = {"build": _cmd_model_build, "info": _cmd_model_info}[args.model_command]
     try:

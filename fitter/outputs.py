@@ -17,7 +17,8 @@ from pathlib import Path
 from bodyfit.calib.files import write_atomic
 from bodyfit.fitter.measurements import MEASUREMENTS
 
-__all__ = ["staged_directory", "write_text", "write_json", "write_measurements"]
+__all__ = ["staged_directory", "write_text", "write_json", "write_measurements",
+           "write_fitted_measurements"]
 
 
 @contextlib.contextmanager
@@ -74,5 +75,28 @@ def write_measurements(json_path: Path, bodies: dict[str, dict[str, float]],
             writer.writerow([body, key, MEASUREMENTS[key][0], f"{value:.2f}"])
     csv_path = json_path.with_suffix(".csv")
     write_json(json_path, payload)
+    write_text(csv_path, buffer.getvalue())
+    return csv_path
+
+
+def write_fitted_measurements(json_path: Path, values: dict[str, float],
+                              spreads: dict[str, float], provenance: dict) -> Path:
+    """Write one fitted body's 16 measurements with their spreads, JSON and CSV (mm).
+
+    Both are keyed by measurement name (``MEASUREMENTS``), with the paper's letter kept
+    as a field: ``{"chest_circumference": {"letter": "D", "value_mm": ..., "spread_mm":
+    ...}, ...}``. Returns the CSV path.
+    """
+    json_path = Path(json_path)
+    table = {name: {"letter": key, "label": label, "value_mm": round(float(values[key]), 2),
+                    "spread_mm": round(float(spreads[key]), 2)}
+             for key, (name, label) in MEASUREMENTS.items()}
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(["measurement", "letter", "value_mm", "spread_mm"])
+    for name, row in table.items():
+        writer.writerow([name, row["letter"], f"{row['value_mm']:.2f}", f"{row['spread_mm']:.2f}"])
+    csv_path = json_path.with_suffix(".csv")
+    write_json(json_path, {"units": "mm", "measurements": table, "provenance": provenance})
     write_text(csv_path, buffer.getvalue())
     return csv_path

@@ -1,0 +1,115 @@
+"""One person's fit: silhouettes -> canvases -> search -> body and measurements with spreads.
+
+The measurement spread: the final population's best quarter of candidates (at least
+three with a finite cost) are measured like the best body, and each measurement's
+spread is their standard deviation, millimetres. It says how well the photos pinned a
+measurement down under this search: a measurement the silhouettes barely constrain
+varies among near-equal candidates. It is not a confidence interval; how often the
+truth falls inside it is for the accuracy benchmark to measure.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+
+from bodyfit import kernels
+from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
+from bodyfit.fitter.canvas import CanvasSettings, model_extent, orthographic_view
+from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
+from bodyfit.fitter.search import SearchResult, SearchSettings, search
+
+__all__ = ["FitSettings", "Fit", "fit_person"]
+
+_SPREAD_SHARE = 0.25
+_SPREAD_MIN = 3
+
+
+@dataclasses.dataclass(frozen=True)
+class FitSettings:
+    """Everything about a fit but the person.
+
+    Attributes:
+        search: optimiser and space.
+        canvas: canvas geometry.
+        cost: the kernels' weights and matching (the paper's Table 2 by default).
+        device: where the kernels run, "cpu" or "cuda:0".
+    """
+
+    search: SearchSettings = SearchSettings()
+    canvas: CanvasSettings = CanvasSettings()
+    cost: kernels.CostSettings = kernels.CostSettings()
+    device: str = "cpu"
+
+
+@dataclasses.dataclass(frozen=True)
+class Fit:
+    """A fitted body.
+
+    Attributes:
+        search: the search's outcome (best parameters, convergence, final population).
+        posed: (V, 3) float32 metres, the best body in its fitted pose.
+        rest: (V, 3) float32 metres, the same body in the rest A-pose.
+        measurements: key ("A".."P") -> mm, of ``rest``.
+        spreads: key -> mm, the spread described in the module docstring.
+        views: the kernels' targets (canvas silhouettes and cameras), by view name.
+        seconds: stage -> wall seconds ("canvas", "search", "measure").
+    """
+
+    search: SearchResult
+    posed: np.ndarray
+    rest: np.ndarray
+    measurements: dict[str, float]
+    spreads: dict[str, float]
+    views: dict[str, kernels.ViewTarget]
+    seconds: dict[str, float]
+
+
+def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult) -> dict[str, float]:
+    finite = np.flatnonzero(np.isfinite(result.final_costs))
+    count = max(_SPREAD_MIN, int(np.ceil(_SPREAD_SHARE * len(result.final_costs))))
+    chosen = finite[np.argsort(result.final_costs[finite])][:count]
+    k = len(result.betas)
+    rest, _ = rest_shape(model, result.final_genes[chosen, :k])
+    values = measurer.measure_many(rest)
+    spread = np.nanstd(values, axis=0, ddof=1) if len(chosen) > 1 else np.full(16, np.nan)
+    return dict(zip(MEASUREMENTS, spread.tolist()))
+
+
+def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
+               settings: FitSettings = FitSettings(), progress: bool | None = None) -> Fit:
+    """Fit the body model to a person's front and side silhouettes.
+
+    Args:
+        model: the body model.
+        masks: {"front": (H, W) bool, "side": (H', W') bool} silhouettes of the photos.
+        stature_m: the person's stature, metres (scales each view, Section 3.3).
+        settings: search, canvas, cost, device.
+        progress: show the search's progress bar (None: when stderr is a terminal).
+    """
+    s = settings.search
+    s.validate(model.num_components)
+    settings.canvas.validate()
+    t0 = time.perf_counter()
+    extent = model_extent(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
+                          settings.canvas.beta_limit)
+    mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
+    views = {name: orthographic_view(name, masks[name], stature_m, extent, mean_body,
+                                     settings.canvas, settings.device)
+             for name in ("front", "side")}
+    arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
+    evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)
+    t1 = time.perf_counter()
+    result = search(evaluator, s, progress)
+    t2 = time.perf_counter()
+    betas = result.betas[None]
+    posed = forward(model, betas, result.pose_deg[None])[0]
+    rest = rest_shape(model, betas)[0][0]
+    measurer = Measurer.from_model(model)
+    measurements = measurer.measure(rest)
+    spreads = _spreads(model, measurer, result)
+    t3 = time.perf_counter()
+    return Fit(result, posed, rest, measurements, spreads, views,
+               {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2})

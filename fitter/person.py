@@ -1,0 +1,93 @@
+"""The person's inputs: two photos (or the user's own masks), the stature, the camera.
+
+Photos go through calib: read in the sensor frame, silhouette on the plain backdrop
+(optionally against a background plate), undistorted with the camera when one is given,
+turned upright by EXIF (:func:`bodyfit.calib.silhouette.photo_silhouette`). A user's
+mask replaces the extraction; it must be of the undistorted, upright photo.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+
+from bodyfit.calib.camera import load_camera
+from bodyfit.calib.errors import UserError
+from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
+
+__all__ = ["PersonInputs", "STATURE_RANGE_CM", "person_masks"]
+
+#: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
+#: most likely given in other units).
+STATURE_RANGE_CM = (100.0, 250.0)
+SEXES = ("female", "male", "unknown")
+
+
+@dataclasses.dataclass(frozen=True)
+class PersonInputs:
+    """What the user gives about one person (paths as given).
+
+    Attributes:
+        front, side: the photos: front in an A-pose, side with the arms hanging down.
+        height_cm: stature, centimetres.
+        camera: camera.json from ``calib capture``, or None.
+        mask_front, mask_side: the user's own silhouettes (white person on black), or None.
+        background_front, background_side: background plates, or None.
+        sex: "female", "male" or "unknown" (recorded; not yet a prior of the search).
+    """
+
+    front: str
+    side: str
+    height_cm: float
+    camera: str | None = None
+    mask_front: str | None = None
+    mask_side: str | None = None
+    background_front: str | None = None
+    background_side: str | None = None
+    sex: str = "unknown"
+
+    def validate(self) -> None:
+        lo, hi = STATURE_RANGE_CM
+        if not lo <= self.height_cm <= hi:
+            raise UserError(f"--height-cm must be a stature in centimetres, {lo:.0f}-{hi:.0f}; "
+                            f"got {self.height_cm:g}")
+        if self.sex not in SEXES:
+            raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
+        for path in (self.front, self.side, self.camera, self.mask_front, self.mask_side,
+                     self.background_front, self.background_side):
+            if path is not None and not Path(path).is_file():
+                raise UserError(f"{path}: no such file")
+
+
+def _view_mask(photo: str, mask: str | None, background: str | None, camera) -> np.ndarray:
+    if mask is not None:
+        return load_mask(mask)
+    return photo_silhouette(photo, camera, background, SilhouetteSettings())
+
+
+def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
+    """{"front": mask, "side": mask}: (H, W) bool silhouettes of the upright photos.
+
+    Raises:
+        UserError: unreadable files, no person, several people, a person cut by the frame,
+            photos of another size than the camera's, or front and side swapped.
+    """
+    inputs.validate()
+    camera = load_camera(inputs.camera) if inputs.camera else None
+    masks = {"front": _view_mask(inputs.front, inputs.mask_front, inputs.background_front, camera),
+             "side": _view_mask(inputs.side, inputs.mask_side, inputs.background_side, camera)}
+    aspect = {}
+    for view, mask in masks.items():
+        rows, cols = np.nonzero(mask)
+        for edge, touching in (("top", rows.min() == 0), ("bottom", rows.max() == mask.shape[0] - 1),
+                               ("left", cols.min() == 0), ("right", cols.max() == mask.shape[1] - 1)):
+            if touching:
+                raise UserError(f"the person in the {view} silhouette touches the {edge} edge of "
+                                "the frame: the whole body must be in the photo")
+        aspect[view] = np.ptp(cols) / max(1, np.ptp(rows))
+    if aspect["side"] > aspect["front"]:
+        raise UserError(f"the side silhouette is wider than the front one ({aspect['side']:.2f} "
+                        f"vs {aspect['front']:.2f} of the height): are --front and --side swapped?")
+    return masks

@@ -1,0 +1,105 @@
+"""`fitter run`: a person's two photos to a measured 3D body, written to a folder.
+
+Outputs, written atomically into OUT (a failed run leaves OUT as it was):
+
+- ``mesh.obj``, ``mesh.ply``: the fitted body in its fitted pose, metres, model frame;
+- ``mesh_rest.ply``: the same body in the rest A-pose (where it is measured);
+- ``measurements.json`` / ``.csv``: the 16 measurements with their spreads, mm;
+- ``convergence.png``: the best and mean cost per generation;
+- ``run.json``: inputs, settings, weights, seed, versions, timings, best cost, parameters.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib.metadata
+import platform
+from pathlib import Path
+
+import numpy as np
+
+from bodyfit import kernels
+from bodyfit.calib.errors import UserError
+from bodyfit.calib.images import write_image
+from bodyfit.fitter.body_model import POSE_NAMES, BodyModel
+from bodyfit.fitter.fit import Fit, FitSettings, fit_person
+from bodyfit.fitter.mesh_io import write_mesh
+from bodyfit.fitter.outputs import staged_directory, write_fitted_measurements, write_json
+from bodyfit.fitter.person import PersonInputs, person_masks
+from bodyfit.fitter.plots import line_chart
+
+__all__ = ["RUN_FILES", "check_output_dir", "run_person", "run_record"]
+
+#: The files every successful run writes into OUT.
+RUN_FILES = ("mesh.obj", "mesh.ply", "mesh_rest.ply", "measurements.json", "measurements.csv",
+             "convergence.png", "run.json")
+
+
+def check_output_dir(out_dir: Path, overwrite: bool) -> None:
+    """Refuse an OUT that is a file, or a folder that is not empty (unless ``overwrite``)."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise UserError(f"output folder {out_dir} is a file")
+    if out_dir.is_dir() and any(out_dir.iterdir()) and not overwrite:
+        raise UserError(f"output folder {out_dir} is not empty; choose another or pass --overwrite")
+
+
+def _versions() -> dict[str, str]:
+    names = ("bodyfit", "warp-lang", "numpy", "opencv-contrib-python-headless", "cma")
+    found = {}
+    for name in names:
+        try:
+            found[name] = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:
+            found[name] = "not installed"
+    return found | {"python": platform.python_version()}
+
+
+def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fit: Fit) -> dict:
+    """The run.json payload: everything needed to repeat and judge the run."""
+    result = fit.search
+    return {
+        "inputs": dataclasses.asdict(inputs),
+        "settings": dataclasses.asdict(settings),
+        "cost_terms": list(kernels.TERM_NAMES),
+        "model": {"settings": model.metadata.get("settings"),
+                  "anny_version": model.metadata.get("anny_version")},
+        "versions": _versions(),
+        "result": {
+            "best_cost": result.cost,
+            "part_costs": dict(zip(kernels.TERM_NAMES, map(float, result.part_costs))),
+            "betas": result.betas.tolist(),
+            "pose_deg": dict(zip(POSE_NAMES, result.pose_deg.tolist())),
+            "evaluations": result.evaluations,
+            "generations": result.generations,
+            "stop_reasons": {k: str(v) for k, v in result.stop_reasons.items()},
+            "best_cost_per_generation": result.best_costs.tolist(),
+        },
+        "timings_s": {k: round(v, 3) for k, v in fit.seconds.items()},
+    }
+
+
+def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, out_dir: Path,
+               overwrite: bool = False, progress: bool | None = None) -> tuple[Fit, list[Path]]:
+    """Fit one person and write the outputs of the module docstring into ``out_dir``.
+
+    Returns:
+        The fit and the paths written.
+    """
+    out_dir = Path(out_dir)
+    check_output_dir(out_dir, overwrite)
+    masks = person_masks(inputs)
+    fit = fit_person(model, masks, inputs.height_cm / 100.0, settings, progress)
+    result = fit.search
+    chart = line_chart({"best so far": result.best_costs, "generation mean": result.mean_costs},
+                       f"search: {settings.search.optimizer}, {result.evaluations} candidates",
+                       "generation", "cost (weighted mm)", log_y=True)
+    with staged_directory(out_dir) as stage:
+        for name, vertices in (("mesh.obj", fit.posed), ("mesh.ply", fit.posed),
+                               ("mesh_rest.ply", fit.rest)):
+            write_mesh(stage / name, vertices, model.faces)
+        write_fitted_measurements(stage / "measurements.json", fit.measurements, fit.spreads,
+                                  {"command": "fitter run", "front": inputs.front,
+                                   "side": inputs.side, "height_cm": inputs.height_cm})
+        write_image(stage / "convergence.png", chart)
+        write_json(stage / "run.json", run_record(inputs, settings, model, fit))
+    return fit, [out_dir / name for name in RUN_FILES]

@@ -1,0 +1,147 @@
+"""The search: an optimiser asks for candidate bodies, the kernels score them, repeat.
+
+A candidate is a vector of ``K + 4`` genes: K shape coefficients (betas, in standard
+deviations, within +-``SearchSettings.beta_limit``) and the four abduction angles of
+``POSE_NAMES`` in degrees, within the pose bounds. Any optimiser of
+:mod:`bodyfit.fitter.optimizers` drives it through ask/tell; the kernels'
+:class:`~bodyfit.kernels.PopulationEvaluator` scores each population in one call.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+from tqdm import tqdm
+
+from bodyfit.calib.errors import UserError
+from bodyfit.fitter.body_model import POSE_NAMES
+from bodyfit.fitter.optimizers import OPTIMIZER_NAMES, make_optimizer
+
+__all__ = ["SearchSettings", "SearchResult", "search"]
+
+
+@dataclasses.dataclass(frozen=True)
+class SearchSettings:
+    """How the body space is searched.
+
+    Attributes:
+        optimizer: one of ``OPTIMIZER_NAMES`` (``"ga"``: the paper's genetic algorithm).
+        population: candidates per generation (None: the optimiser's default).
+        generations: generations at most (None: the optimiser's default, the paper's 25).
+        components: K, shape components searched (the paper: 20; up to those stored).
+        beta_limit: betas lie within +-this many standard deviations (the paper: 3).
+        pose_lower_deg, pose_upper_deg: bounds of the four abduction angles, degrees
+            (the paper: 0-30; people also hold their limbs a little closer than the
+            model's A-pose, hence -10 by default).
+        seed: the optimiser's random seed; the same seed gives the same search.
+    """
+
+    optimizer: str = "ga"
+    population: int | None = None
+    generations: int | None = None
+    components: int = 20
+    beta_limit: float = 3.0
+    pose_lower_deg: tuple[float, ...] = (-10.0,) * len(POSE_NAMES)
+    pose_upper_deg: tuple[float, ...] = (30.0,) * len(POSE_NAMES)
+    seed: int = 0
+
+    def validate(self, stored_components: int) -> None:
+        if self.optimizer not in OPTIMIZER_NAMES:
+            raise UserError(f"--optimizer must be one of {', '.join(OPTIMIZER_NAMES)}, "
+                            f"got {self.optimizer!r}")
+        if not 1 <= self.components <= stored_components:
+            raise UserError(f"--components must be 1-{stored_components} (the components "
+                            f"the body model stores), got {self.components}")
+        for name, value, least in (("--population", self.population, 4),
+                                   ("--generations", self.generations, 1)):
+            if value is not None and value < least:
+                raise UserError(f"{name} must be at least {least}, got {value}")
+        if not all(lo < hi for lo, hi in zip(self.pose_lower_deg, self.pose_upper_deg)):
+            raise UserError("every pose lower bound must lie below its upper bound")
+
+    @property
+    def lower(self) -> np.ndarray:
+        """(K + 4,) float64 lower bounds of the genes."""
+        return np.r_[np.full(self.components, -self.beta_limit), self.pose_lower_deg]
+
+    @property
+    def upper(self) -> np.ndarray:
+        """(K + 4,) float64 upper bounds of the genes."""
+        return np.r_[np.full(self.components, self.beta_limit), self.pose_upper_deg]
+
+
+@dataclasses.dataclass(frozen=True)
+class SearchResult:
+    """The outcome of :func:`search`.
+
+    Attributes:
+        betas: (K,) float64 best shape, standard deviations.
+        pose_deg: (4,) float64 best pose, degrees, ``POSE_NAMES`` order.
+        cost: the best cost, weighted millimetres.
+        part_costs: (11,) float32, the best candidate's terms (``kernels.TERM_NAMES``).
+        best_costs, mean_costs: (G,) per generation, the best so far and the mean of the
+            finite costs of that generation.
+        final_genes: (P, K + 4) float64 the last population, ``final_costs`` (P,) its costs.
+        evaluations: candidates scored; generations: G; seconds: wall time.
+        stop_reasons: the optimiser's reasons for stopping.
+    """
+
+    betas: np.ndarray
+    pose_deg: np.ndarray
+    cost: float
+    part_costs: np.ndarray
+    best_costs: np.ndarray
+    mean_costs: np.ndarray
+    final_genes: np.ndarray
+    final_costs: np.ndarray
+    evaluations: int
+    generations: int
+    seconds: float
+    stop_reasons: dict
+
+
+def search(evaluator, settings: SearchSettings, progress: bool | None = None) -> SearchResult:
+    """Search the body space against the evaluator's views.
+
+    Args:
+        evaluator: a :class:`bodyfit.kernels.PopulationEvaluator` over the person's views,
+            built for ``settings.components`` betas.
+        settings: the optimiser and the space.
+        progress: a progress bar with the best cost per generation on stderr (None: only
+            when stderr is a terminal).
+    """
+    k = settings.components
+    budget = {} if settings.generations is None else {"generations": settings.generations}
+    optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
+                               population=settings.population, seed=settings.seed, **budget)
+    start = time.perf_counter()
+    best_costs, mean_costs = [], []
+    best = (np.inf, None, None)
+    evaluations = 0
+    with tqdm(desc=f"search ({settings.optimizer})", unit="gen", dynamic_ncols=True,
+              disable=None if progress is None else not progress) as bar:
+        while not optimizer.stop():
+            genes = optimizer.ask()
+            scored = evaluator.evaluate(genes[:, :k], genes[:, k:])
+            costs = scored.costs.astype(np.float64)
+            optimizer.tell(genes, costs)
+            evaluations += len(genes)
+            i = int(np.argmin(costs))
+            if costs[i] < best[0]:
+                best = (float(costs[i]), genes[i].copy(), scored.part_costs[i].copy())
+            finite = costs[np.isfinite(costs)]
+            best_costs.append(best[0])
+            mean_costs.append(float(finite.mean()) if finite.size else np.inf)
+            bar.update(1)
+            bar.set_postfix(best=f"{best[0]:.1f}")
+            last_genes, last_costs = genes, costs
+    if best[1] is None:
+        raise UserError("no candidate body produced a silhouette; check the photos and masks")
+    return SearchResult(
+        betas=best[1][:k], pose_deg=best[1][k:], cost=best[0], part_costs=best[2],
+        best_costs=np.array(best_costs), mean_costs=np.array(mean_costs),
+        final_genes=last_genes, final_costs=last_costs, evaluations=evaluations,
+        generations=len(best_costs), seconds=time.perf_counter() - start,
+        stop_reasons=dict(optimizer.stop()))

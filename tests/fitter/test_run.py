@@ -1,0 +1,122 @@
+"""`fitter run` end to end on synthetic photos, its outputs, and its bad input."""
+
+import json
+
+import cv2
+import numpy as np
+import pytest
+
+from bodyfit.fitter.cli import main
+from bodyfit.fitter.run import RUN_FILES
+from bodyfit.fitter.studio_photos import write_subject
+
+TRUE_BETAS = np.array([0.8, -0.6, 0.5, 0.3, -0.4] + [0.0] * 15)
+TRUE_POSE = np.array([6.0, 6.0, 3.0, 3.0])
+BUDGET = ["--optimizer", "cmaes", "--population", "24", "--generations", "30", "--seed", "1"]
+
+
+@pytest.fixture(scope="module")
+def subject(body_model, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("subject")
+    truth = write_subject(folder, body_model, TRUE_BETAS, TRUE_POSE)
+    return folder, truth
+
+
+def run(capsys, *argv):
+    code = main(["-q", *argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def person_args(folder, truth):
+    return ["--front", str(folder / "front.png"), "--side", str(folder / "side.png"),
+            "--height-cm", f"{truth['O'] / 10:.2f}"]
+
+
+def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, capsys):
+    folder, truth = subject
+    out = tmp_path / "out"
+    code, stdout, err = run(capsys, "run", *person_args(folder, truth), "-o", str(out), *BUDGET)
+    assert code == 0, err
+    assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES)
+    assert "chest circumference" in stdout and str(out / "mesh.obj") in stdout
+    table = json.loads((out / "measurements.json").read_text())["measurements"]
+    assert len(table) == 16 and table["stature"]["letter"] == "O"
+    assert all(row["spread_mm"] >= 0 for row in table.values())
+    # stature is pinned by the canvas scale; the search must keep it
+    assert abs(table["stature"]["value_mm"] - truth["O"]) < 15.0
+    record = json.loads((out / "run.json").read_text())
+    assert record["settings"]["search"]["optimizer"] == "cmaes"
+    assert record["result"]["evaluations"] == 24 * 30
+    costs = record["result"]["best_cost_per_generation"]
+    assert costs[-1] < costs[0] and all(np.diff(costs) <= 0)
+    assert cv2.imread(str(out / "convergence.png")).shape == (480, 800, 3)
+
+
+def test_same_seed_same_result(subject, tmp_path, capsys):
+    folder, truth = subject
+    budget = ["--optimizer", "ga", "--population", "12", "--generations", "3", "--seed", "4"]
+    runs = []
+    for name in ("a", "b"):
+        code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
+                           str(tmp_path / name), *budget)
+        assert code == 0, err
+        runs.append(json.loads((tmp_path / name / "run.json").read_text())["result"])
+    assert runs[0]["betas"] == runs[1]["betas"] and runs[0]["best_cost"] == runs[1]["best_cost"]
+
+
+def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
+    folder, truth = subject
+    budget = ["--optimizer", "ga", "--population", "8", "--generations", "1"]
+    costs = {}
+    for name, extra in (("paper", []), ("waist", ["--weight", "waist=50"])):
+        code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
+                           str(tmp_path / name), *budget, *extra)
+        assert code == 0, err
+        record = json.loads((tmp_path / name / "run.json").read_text())
+        costs[name] = record["result"]["part_costs"]["waist"]
+        assert record["settings"]["cost"]["part_weights"][2] == (50.0 if extra else 5.0)
+    assert costs["waist"] == pytest.approx(10 * costs["paper"], rel=1e-4)
+
+
+@pytest.mark.parametrize("change,message", [
+    ({"--height-cm": "1.80"}, "centimetres"),
+    ({"--height-cm": "400"}, "centimetres"),
+    ({"--front": "missing.png"}, "no such file"),
+    ({"--weight": "knee=3"}, "unknown"),
+    ({"--weight": "waist"}, "NAME=VALUE|="),
+    ({"--weights": "heavy"}, "heavy"),
+    ({"--optimizer": "sgd"}, "invalid choice"),
+    ({"--components": "99"}, "components"),
+    ({"--matching": "both"}, "matching"),
+    ({"swap": True}, "swapped"),
+    ({"blank": True}, "no person"),
+])
+def test_bad_input_is_one_line_exit_2_and_writes_nothing(subject, tmp_path, capsys,
+                                                         change, message):
+    folder, truth = subject
+    args = dict(zip(person_args(folder, truth)[::2], person_args(folder, truth)[1::2]))
+    if change.pop("swap", False):
+        args["--front"], args["--side"] = args["--side"], args["--front"]
+    if change.pop("blank", False):
+        blank = tmp_path / "blank.png"
+        cv2.imwrite(str(blank), np.full((800, 600, 3), 180, np.uint8))
+        args["--front"] = str(blank)
+    args.update(change)
+    argv = [item for pair in args.items() for item in pair]
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "run", *argv, "-o", str(out), "--generations", "1")
+    assert code == 2
+    assert err.startswith("fitter: error:") and len(err.strip().splitlines()) == 1
+    import re
+    assert re.search(message, err), err
+    assert not out.exists()
+
+
+def test_non_empty_output_folder_needs_overwrite(subject, tmp_path, capsys):
+    folder, truth = subject
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "notes.txt").write_text("mine")
+    code, _, err = run(capsys, "run", *person_args(folder, truth), "-o", str(tmp_path / "out"))
+    assert code == 2 and "not empty" in err and "--overwrite" in err
+    assert [p.name for p in (tmp_path / "out").iterdir()] == ["notes.txt"]

@@ -1,0 +1,89 @@
+"""Benchmark of `fitter run`: measurement error against time, per search setting.
+
+    python tools/bench_fitter.py                    # 4 subjects, the settings below
+    python tools/bench_fitter.py --subjects 8 --seed 3
+
+In-space subjects: bodies drawn from the model's own 20-component space (betas normal,
+clipped at +-2 sigma; limbs 2-8 degrees out), photographed front and side by
+:mod:`bodyfit.fitter.studio_photos` (a painter's renderer, not the kernels; orthographic,
+700 px tall), then fitted by the `fitter run` command itself, start-up included, once per
+setting. Error: |fitted - true| of the 16 measurements, mm. Prints Markdown (docs/fitter.md
+holds the output).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
+from bodyfit.fitter.model_cache import load_model
+from bodyfit.fitter.studio_photos import write_subject
+
+#: name -> `fitter run` options; the first is the paper's method and budget.
+SETTINGS = {
+    "paper GA, 30 x 25": ["--optimizer", "ga"],
+    "GA, 120 x 75": ["--optimizer", "ga", "--population", "120", "--generations", "75"],
+    "CMA-ES, 30 x 100": ["--optimizer", "cmaes", "--population", "30", "--generations", "100"],
+    "CMA-ES, 60 x 150, symmetric": ["--optimizer", "cmaes", "--population", "60",
+                                    "--generations", "150", "--matching", "symmetric"],
+}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--subjects", type=int, default=4)
+    parser.add_argument("--seed", type=int, default=7)
+    args = parser.parse_args()
+    model = load_model()
+    rng = np.random.default_rng(args.seed)
+    errors = {name: [] for name in SETTINGS}
+    seconds = {name: [] for name in SETTINGS}
+    with tempfile.TemporaryDirectory() as scratch:
+        for i in range(args.subjects):
+            folder = Path(scratch) / f"s{i}"
+            folder.mkdir()
+            betas = np.clip(rng.standard_normal(20), -2, 2)
+            pose = rng.uniform(2, 8, 4)
+            truth = write_subject(folder, model, betas, pose)
+            for name, options in SETTINGS.items():
+                out = folder / name.replace(" ", "_").replace(",", "")
+                start = time.perf_counter()
+                subprocess.run(["fitter", "-q", "run", "--front", str(folder / "front.png"),
+                                "--side", str(folder / "side.png"), "--height-cm",
+                                f"{truth['O'] / 10:.2f}", "-o", str(out), *options],
+                               check=True, stdout=subprocess.DEVNULL)
+                seconds[name].append(time.perf_counter() - start)
+                table = json.loads((out / "measurements.json").read_text())["measurements"]
+                errors[name].append([table[MEASUREMENTS[k][0]]["value_mm"] - truth[k]
+                                     for k in MEASUREMENTS])
+    keys = list(MEASUREMENTS)
+    important = [keys.index(k) for k in IMPORTANT]
+    print(f"`python tools/bench_fitter.py --subjects {args.subjects} --seed {args.seed}` on "
+          f"{time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
+          f"`fitter run` on the CPU, start-up included.\n")
+    print("| setting | candidates | wall s (mean) | 7 important, mean abs. error (mm) | "
+          + " | ".join(IMPORTANT) + " | O |")
+    print("|---|---|---|---|" + "---|" * (len(IMPORTANT) + 1))
+    for name, options in SETTINGS.items():
+        err = np.abs(np.array(errors[name]))
+        pop = int(options[options.index("--population") + 1]) if "--population" in options else 30
+        gens = int(options[options.index("--generations") + 1]) if "--generations" in options else 25
+        print(f"| {name} | {pop * gens} | {np.mean(seconds[name]):.1f} | "
+              f"{err[:, important].mean():.1f} | "
+              + " | ".join(f"{err[:, i].mean():.1f}" for i in important)
+              + f" | {err[:, keys.index('O')].mean():.1f} |")
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()
