@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import importlib.metadata
 import json
 import logging
 import sys
@@ -30,6 +29,7 @@ from bodyfit.calib.capture import (
 )
 from bodyfit.calib.check import CheckedView, check_calibration, rms_px
 from bodyfit.calib.coverage import coverage_fraction, coverage_picture
+from bodyfit.calib.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import check_writable_dir, file_sha256, write_atomic
 from bodyfit.calib.images import encode_image, read_photo, to_upright, write_image
@@ -39,20 +39,6 @@ from bodyfit.calib.undistort import undistort_image
 __all__ = ["main"]
 
 _DEFAULTS = CaptureSettings()
-
-
-class _Parser(argparse.ArgumentParser):
-    """argparse that reports usage errors in one line, like every other calib error."""
-
-    def error(self, message: str) -> None:  # noqa: D102 - argparse's hook
-        self.exit(2, f"calib: error: {message} (see `{self.prog} --help`)\n")
-
-
-def _version() -> str:
-    try:
-        return importlib.metadata.version("bodyfit")
-    except importlib.metadata.PackageNotFoundError:
-        return "unknown"
 
 
 def _add_board_arguments(parser: argparse.ArgumentParser, required: bool) -> None:
@@ -77,12 +63,12 @@ def _board(args: argparse.Namespace) -> BoardSpec:
 
 
 def _build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(
+    parser = OneLineArgumentParser(
         prog="calib",
         description="Calibrate a phone camera, undistort photos, extract silhouettes. "
         "Board sizes in millimetres, image measures in pixels.",
     )
-    parser.add_argument("--version", action="version", version=f"bodyfit {_version()}")
+    parser.add_argument("--version", action="version", version=f"bodyfit {bodyfit_version()}")
     parser.add_argument("-v", "--verbose", action="store_true", help="log every step to stderr")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -192,7 +178,7 @@ def _capture(args: argparse.Namespace, argv: list[str]) -> None:
             "argv": argv,
             "inputs": list(args.inputs),
             "input_sha256": [file_sha256(path) for path in args.inputs],
-            "bodyfit_version": _version(),
+            "bodyfit_version": bodyfit_version(),
             "opencv_version": cv2.__version__,
             "time": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         },

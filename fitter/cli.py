@@ -7,12 +7,12 @@ The help says only what exists. User errors, usage errors included, print one li
 from __future__ import annotations
 
 import argparse
-import importlib.metadata
 import logging
 import sys
 import time
 from pathlib import Path
 
+from bodyfit.calib.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.calib.errors import UserError
 
 __all__ = ["main"]
@@ -20,27 +20,13 @@ __all__ = ["main"]
 logger = logging.getLogger("bodyfit")
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse that reports usage errors in one line, like every other fitter error."""
-
-    def error(self, message: str) -> None:  # noqa: D102 - argparse's hook
-        self.exit(2, f"fitter: error: {message} (see `{self.prog} --help`)\n")
-
-
-def _version() -> str:
-    try:
-        return importlib.metadata.version("bodyfit")
-    except importlib.metadata.PackageNotFoundError:
-        return "unknown"
-
-
 def _build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(
+    parser = OneLineArgumentParser(
         prog="fitter",
         description="bodyfit: a 3D body and 16 tape measurements from a front and a side "
                     "photo (fitter run); draw and measure bodies of the model. Lengths in "
                     "files are metres (meshes) and millimetres (measurements).")
-    parser.add_argument("--version", action="version", version=f"bodyfit {_version()}")
+    parser.add_argument("--version", action="version", version=f"bodyfit {bodyfit_version()}")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
