@@ -220,7 +220,8 @@ def main(argv: list[str] | None = None) -> int:
         return int(stop.code or 0)
     logging.basicConfig(level=logging.ERROR if args.quiet else logging.INFO,
                         format="%(message)s")
-    logging.getLogger("anny").setLevel(logging.WARNING)
+    for chatty in ("anny", "bodyfit.calib"):  # their steps are logged for `calib -v`
+        logging.getLogger(chatty).setLevel(logging.WARNING)
     import warp  # Warp prints its banner and module loads at INFO; the CLI keeps to errors
 
     warp.config.log_level = warp.LOG_ERROR
