@@ -91,6 +91,10 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--components", type=int, default=20,
                      help="shape components searched (default 20, as the paper; up to 60)")
     run.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    run.add_argument("--free-stature", action="store_true",
+                     help="search the first shape component like the others (the paper) "
+                          "instead of solving it so every candidate stands as tall as the "
+                          "person")
     run.add_argument("--device", default="cpu", help="cpu (default) or cuda:0")
     run.add_argument("--overwrite", action="store_true", help="write into a non-empty OUT")
 
@@ -174,7 +178,7 @@ def _cmd_run(args) -> None:
         settings = FitSettings(
             search=SearchSettings(optimizer=args.optimizer, population=args.population,
                                   generations=args.generations, components=args.components,
-                                  seed=args.seed),
+                                  seed=args.seed, condition_stature=not args.free_stature),
             cost=cost_settings(args.weights, args.weight, CostSettings(matching=args.matching)),
             device=args.device)
         model = load_model()

@@ -20,6 +20,7 @@ from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import CanvasSettings, model_extent, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
+from bodyfit.fitter.stature import StatureConditioner, stature_scale
 
 __all__ = ["FitSettings", "Fit", "fit_person"]
 
@@ -67,12 +68,17 @@ class Fit:
     seconds: dict[str, float]
 
 
-def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult) -> dict[str, float]:
+def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult,
+             stature_m: float | None) -> dict[str, float]:
+    """The spread of each measurement (module docstring); each candidate rescaled to
+    ``stature_m`` first when given (as the fitted body is)."""
     finite = np.flatnonzero(np.isfinite(result.final_costs))
     count = max(_SPREAD_MIN, int(np.ceil(_SPREAD_SHARE * len(result.final_costs))))
     chosen = finite[np.argsort(result.final_costs[finite])][:count]
     k = len(result.betas)
     rest, _ = rest_shape(model, result.final_genes[chosen, :k])
+    if stature_m is not None:
+        rest = np.stack([body * stature_scale(body, stature_m) for body in rest])
     values = measurer.measure_many(rest)
     spread = np.nanstd(values, axis=0, ddof=1) if len(chosen) > 1 else np.full(16, np.nan)
     return dict(zip(MEASUREMENTS, spread.tolist()))
@@ -101,15 +107,22 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
              for name in ("front", "side")}
     arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)
+    conditioner = None
+    if s.condition_stature:
+        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit,
+                                         s.pose_lower_deg, s.pose_upper_deg)
     t1 = time.perf_counter()
-    result = search(evaluator, s, progress)
+    result = search(evaluator, s, conditioner, progress)
     t2 = time.perf_counter()
     betas = result.betas[None]
     posed = forward(model, betas, result.pose_deg[None])[0]
     rest = rest_shape(model, betas)[0][0]
+    if s.condition_stature:  # the fit stands as tall as the person's stature: rescale it
+        scale = stature_scale(rest, stature_m)
+        posed, rest = posed * scale, rest * scale
     measurer = Measurer.from_model(model)
     measurements = measurer.measure(rest)
-    spreads = _spreads(model, measurer, result)
+    spreads = _spreads(model, measurer, result, stature_m if s.condition_stature else None)
     t3 = time.perf_counter()
     return Fit(result, posed, rest, measurements, spreads, views,
                {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2})

@@ -1,7 +1,8 @@
 """The search: an optimiser asks for candidate bodies, the kernels score them, repeat.
 
-A candidate is a vector of ``K + 4`` genes: K shape coefficients (betas, in standard
-deviations, within +-``SearchSettings.beta_limit``) and the four abduction angles of
+A candidate is a vector of genes: the K shape coefficients (betas, in standard
+deviations, within +-``SearchSettings.beta_limit``; the first one left out and solved
+from the stature when ``condition_stature``) and the four abduction angles of
 ``POSE_NAMES`` in degrees, within the pose bounds. Any optimiser of
 :mod:`bodyfit.fitter.optimizers` drives it through ask/tell; the kernels'
 :class:`~bodyfit.kernels.PopulationEvaluator` scores each population in one call.
@@ -36,6 +37,9 @@ class SearchSettings:
             (the paper: 0-30; people also hold their limbs a little closer than the
             model's A-pose, hence -10 by default).
         seed: the optimiser's random seed; the same seed gives the same search.
+        condition_stature: solve each candidate's first beta so that it stands as tall as
+            the person (:mod:`bodyfit.fitter.stature`) instead of searching it (the paper
+            searches it).
     """
 
     optimizer: str = "ga"
@@ -46,6 +50,7 @@ class SearchSettings:
     pose_lower_deg: tuple[float, ...] = (-10.0,) * len(POSE_NAMES)
     pose_upper_deg: tuple[float, ...] = (30.0,) * len(POSE_NAMES)
     seed: int = 0
+    condition_stature: bool = True
 
     def validate(self, stored_components: int) -> None:
         if self.optimizer not in OPTIMIZER_NAMES:
@@ -62,14 +67,19 @@ class SearchSettings:
             raise UserError("every pose lower bound must lie below its upper bound")
 
     @property
+    def searched_betas(self) -> int:
+        """Betas among the genes: K, or K - 1 when the first is solved from the stature."""
+        return self.components - int(self.condition_stature)
+
+    @property
     def lower(self) -> np.ndarray:
-        """(K + 4,) float64 lower bounds of the genes."""
-        return np.r_[np.full(self.components, -self.beta_limit), self.pose_lower_deg]
+        """(searched betas + 4,) float64 lower bounds of the genes."""
+        return np.r_[np.full(self.searched_betas, -self.beta_limit), self.pose_lower_deg]
 
     @property
     def upper(self) -> np.ndarray:
-        """(K + 4,) float64 upper bounds of the genes."""
-        return np.r_[np.full(self.components, self.beta_limit), self.pose_upper_deg]
+        """(searched betas + 4,) float64 upper bounds of the genes."""
+        return np.r_[np.full(self.searched_betas, self.beta_limit), self.pose_upper_deg]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -83,7 +93,8 @@ class SearchResult:
         part_costs: (11,) float32, the best candidate's terms (``kernels.TERM_NAMES``).
         best_costs, mean_costs: (G,) per generation, the best so far and the mean of the
             finite costs of that generation.
-        final_genes: (P, K + 4) float64 the last population, ``final_costs`` (P,) its costs.
+        final_genes: (P, K + 4) float64 the last population (all K betas, then the pose),
+            ``final_costs`` (P,) its costs.
         evaluations: candidates scored; generations: G; seconds: wall time.
         stop_reasons: the optimiser's reasons for stopping.
     """
@@ -102,17 +113,27 @@ class SearchResult:
     stop_reasons: dict
 
 
-def search(evaluator, settings: SearchSettings, progress: bool | None = None) -> SearchResult:
+def search(evaluator, settings: SearchSettings, conditioner=None,
+           progress: bool | None = None) -> SearchResult:
     """Search the body space against the evaluator's views.
 
     Args:
         evaluator: a :class:`bodyfit.kernels.PopulationEvaluator` over the person's views,
             built for ``settings.components`` betas.
         settings: the optimiser and the space.
+        conditioner: a :class:`bodyfit.fitter.stature.StatureConditioner`, required when
+            ``settings.condition_stature``: it turns the searched genes into full betas.
         progress: a progress bar with the best cost per generation on stderr (None: only
             when stderr is a terminal).
     """
-    k = settings.components
+    k = settings.searched_betas
+    if settings.condition_stature and conditioner is None:
+        raise ValueError("condition_stature needs a StatureConditioner")
+
+    def betas_of(genes: np.ndarray) -> np.ndarray:
+        if not settings.condition_stature:
+            return genes[:, :k]
+        return conditioner.complete(genes[:, :k], genes[:, k:])
     budget = {} if settings.generations is None else {"generations": settings.generations}
     optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
                                population=settings.population, seed=settings.seed, **budget)
@@ -124,23 +145,26 @@ def search(evaluator, settings: SearchSettings, progress: bool | None = None) ->
               disable=None if progress is None else not progress) as bar:
         while not optimizer.stop():
             genes = optimizer.ask()
-            scored = evaluator.evaluate(genes[:, :k], genes[:, k:])
+            betas = betas_of(genes)
+            scored = evaluator.evaluate(betas, genes[:, k:])
             costs = scored.costs.astype(np.float64)
             optimizer.tell(genes, costs)
             evaluations += len(genes)
             i = int(np.argmin(costs))
             if costs[i] < best[0]:
-                best = (float(costs[i]), genes[i].copy(), scored.part_costs[i].copy())
+                best = (float(costs[i]), np.r_[betas[i], genes[i, k:]],
+                        scored.part_costs[i].copy())
             finite = costs[np.isfinite(costs)]
             best_costs.append(best[0])
             mean_costs.append(float(finite.mean()) if finite.size else np.inf)
             bar.update(1)
             bar.set_postfix(best=f"{best[0]:.1f}")
-            last_genes, last_costs = genes, costs
+            last_genes, last_costs = np.concatenate([betas, genes[:, k:]], axis=1), costs
     if best[1] is None:
         raise UserError("no candidate body produced a silhouette; check the photos and masks")
+    full = settings.components
     return SearchResult(
-        betas=best[1][:k], pose_deg=best[1][k:], cost=best[0], part_costs=best[2],
+        betas=best[1][:full], pose_deg=best[1][full:], cost=best[0], part_costs=best[2],
         best_costs=np.array(best_costs), mean_costs=np.array(mean_costs),
         final_genes=last_genes, final_costs=last_costs, evaluations=evaluations,
         generations=len(best_costs), seconds=time.perf_counter() - start,

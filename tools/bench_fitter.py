@@ -29,13 +29,17 @@ from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.studio_photos import write_subject
 
-#: name -> `fitter run` options; the first is the paper's method and budget.
+#: name -> `fitter run` options; the first is the paper's method and budget. Unless said,
+#: the first shape component is solved from the stature (bodyfit.fitter.stature).
 SETTINGS = {
-    "paper GA, 30 x 25": ["--optimizer", "ga"],
-    "GA, 120 x 75": ["--optimizer", "ga", "--population", "120", "--generations", "75"],
-    "CMA-ES, 30 x 100": ["--optimizer", "cmaes", "--population", "30", "--generations", "100"],
-    "CMA-ES, 60 x 150, symmetric": ["--optimizer", "cmaes", "--population", "60",
-                                    "--generations", "150", "--matching", "symmetric"],
+    "paper: GA 30 x 25, stature searched": ["--optimizer", "ga", "--free-stature"],
+    "GA 30 x 25": ["--optimizer", "ga"],
+    "CMA-ES 30 x 100": ["--optimizer", "cmaes", "--population", "30", "--generations", "100"],
+    "CMA-ES 60 x 150, symmetric, stature searched": [
+        "--optimizer", "cmaes", "--population", "60", "--generations", "150",
+        "--matching", "symmetric", "--free-stature"],
+    "CMA-ES 60 x 150, symmetric": ["--optimizer", "cmaes", "--population", "60",
+                                   "--generations", "150", "--matching", "symmetric"],
 }
 
 

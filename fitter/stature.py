@@ -1,0 +1,123 @@
+"""Conditioning candidates on the known stature: every candidate stands as tall as the person.
+
+The canvas is scaled so that the person's standing silhouette is ``body_height_px`` tall
+at ``body_height_px / stature`` pixels per metre (:mod:`bodyfit.fitter.canvas`). Along
+the first shape component (mostly stature) the cost is steep: +-0.1 sigma costs as much
+as a whole sigma of most others, so a search spends its budget there. Here the first
+beta is not searched but solved, per candidate, so that the candidate's *posed* height
+(its silhouette's height: top of the head to the lowest sole, with its legs apart) equals
+the stature: every candidate then fills the person's silhouette height exactly, and the
+search is over the shape's other components and the pose.
+
+A person standing with the legs apart is a few millimetres lower than their stature, so
+the fitted body stands ``stature`` tall where the person stands ``stature - delta``: it is
+the person scaled by ``stature / (stature - delta)``. :func:`stature_scale` undoes that: the
+fitted body is scaled uniformly so that its rest stature is the given one.
+
+The posed vertices are linear in the betas for a fixed pose (Eq. 1-3 with the rotations
+fixed), so the posed height is piecewise linear in the first beta; Newton steps on the
+vertices near the top and the bottom of the body converge in a few iterations.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from bodyfit.fitter.body_model import BodyModel, abduction_rotations, forward
+
+__all__ = ["StatureConditioner", "stature_scale"]
+
+#: Vertices within this distance (metres) of the top or bottom of any extreme body are
+#: the candidates for a body's highest and lowest points.
+_EXTREME_BAND_M = 0.06
+_ITERATIONS = 6
+
+
+class StatureConditioner:
+    """Solves each candidate's first beta so that its posed height is ``height_m``.
+
+    Args:
+        model: the body model.
+        num_betas: K, the betas of a full candidate.
+        height_m: the posed height every candidate must have, metres.
+        beta_limit: the solved beta is kept within +-this (a body that cannot reach the
+            height inside it keeps the limit, and its silhouette's height then differs).
+        pose_lower, pose_upper: (4,) degrees, the pose range the extreme vertices must cover.
+    """
+
+    def __init__(self, model: BodyModel, num_betas: int, height_m: float,
+                 beta_limit: float, pose_lower, pose_upper):
+        self.num_betas = num_betas
+        self.height_m = float(height_m)
+        self.beta_limit = float(beta_limit)
+        band = self._extreme_vertices(model, num_betas, beta_limit, pose_lower, pose_upper)
+        self._model = dataclasses.replace(
+            model, mean_vertices=model.mean_vertices[band],
+            vertex_components=model.vertex_components[:, band],
+            chain_weights=model.chain_weights[band], vertex_parts=model.vertex_parts[band])
+
+    @staticmethod
+    def _extreme_vertices(model, k, limit, pose_lower, pose_upper) -> np.ndarray:
+        """Indices of the vertices that can be a body's highest or lowest point."""
+        betas = np.concatenate([np.zeros((1, k)), limit * np.eye(k), -limit * np.eye(k)])
+        z = np.concatenate([forward(model, betas, np.broadcast_to(np.asarray(p, float),
+                                                                  (len(betas), 4)))[..., 2]
+                            for p in (pose_lower, pose_upper)])
+        top = z >= z.max(axis=1, keepdims=True) - _EXTREME_BAND_M
+        bottom = z <= z.min(axis=1, keepdims=True) + _EXTREME_BAND_M
+        return np.flatnonzero((top | bottom).any(axis=0))
+
+    def _posed_heights_basis(self, pose_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The posed z of the extreme vertices as an affine function of the betas.
+
+        For a fixed pose, Eq. 2 is linear in the rest vertices and joints, so
+        ``z = z0 + G @ betas`` with z0 (P, V') the mean body's and G (P, V', K) metres per
+        sigma: z = (1 - sum_c w_c) v_z + sum_c w_c (R_c v + (I - R_c) j_c)_z.
+        """
+        m = self._model
+        rz = abduction_rotations(pose_deg)[:, :, 2, :]  # (P, 4, 3): the z rows
+        joint_rz = np.eye(3)[2] - rz  # (P, 4, 3)
+        w = m.chain_weights.astype(np.float64)
+        free = 1.0 - w.sum(axis=1)
+        vertex_dirs, joint_dirs = m.shape_directions(self.num_betas)
+
+        def posed_z(vertices, joints, spec):
+            own = np.einsum(f"v,{spec[0]}->{spec[1]}", free, vertices[..., 2], optimize=True)
+            moved = np.einsum(f"vc,pcd,{spec[2]}->{spec[3]}", w, rz, vertices, optimize=True)
+            hinge = np.einsum(f"vc,pcd,{spec[4]}->{spec[5]}", w, joint_rz, joints, optimize=True)
+            return own + moved + hinge
+
+        z0 = posed_z(m.mean_vertices.astype(np.float64), m.mean_joints.astype(np.float64),
+                     ("v", "v", "vd", "pv", "cd", "pv"))
+        grad = posed_z(vertex_dirs.astype(np.float64), joint_dirs.astype(np.float64),
+                       ("kv", "vk", "kvd", "pvk", "kcd", "pvk"))
+        return z0, grad
+
+    def complete(self, other_betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
+        """(P, K) float64 betas: the solved first beta, then ``other_betas``.
+
+        Args:
+            other_betas: (P, K - 1) betas 2..K, standard deviations.
+            pose_deg: (P, 4) degrees.
+        """
+        other_betas = np.asarray(other_betas, np.float64)
+        z0, grad = self._posed_heights_basis(np.asarray(pose_deg, np.float64))
+        base = z0 + np.einsum("pvk,pk->pv", grad[:, :, 1:], other_betas)  # (P, V')
+        slope = grad[:, :, 0]
+        first = np.zeros(len(other_betas))
+        rows = np.arange(len(first))
+        for _ in range(_ITERATIONS):
+            z = base + first[:, None] * slope
+            top, bottom = z.argmax(axis=1), z.argmin(axis=1)
+            height = z[rows, top] - z[rows, bottom]
+            rate = slope[rows, top] - slope[rows, bottom]  # metres per sigma
+            first = np.clip(first + (self.height_m - height) / rate,
+                            -self.beta_limit, self.beta_limit)
+        return np.concatenate([first[:, None], other_betas], axis=1)
+
+
+def stature_scale(rest_vertices: np.ndarray, stature_m: float) -> float:
+    """The uniform scale that gives a (V, 3) rest body the stature ``stature_m``."""
+    return float(stature_m / np.ptp(rest_vertices[:, 2]))

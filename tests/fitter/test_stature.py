@@ -1,0 +1,43 @@
+"""Candidates conditioned on the stature: the solved first beta gives the posed height."""
+
+import numpy as np
+import pytest
+
+from bodyfit.fitter.body_model import forward, rest_shape
+from bodyfit.fitter.search import SearchSettings
+from bodyfit.fitter.stature import StatureConditioner, stature_scale
+
+
+@pytest.mark.parametrize("height_m", [1.55, 1.75, 1.95])
+def test_solved_first_beta_gives_the_posed_height(body_model, height_m):
+    """Checked with the NumPy forward on every vertex (the solver sees only the extremes
+    through its linear map)."""
+    rng = np.random.default_rng(2)
+    conditioner = StatureConditioner(body_model, 20, height_m, 3.0, [-10] * 4, [30] * 4)
+    other, pose = rng.uniform(-1.5, 1.5, (12, 19)), rng.uniform(-10, 30, (12, 4))
+    betas = conditioner.complete(other, pose)
+    np.testing.assert_array_equal(betas[:, 1:], other)
+    z = forward(body_model, betas, pose)[..., 2]
+    heights = z.max(axis=1) - z.min(axis=1)
+    free = np.abs(betas[:, 0]) < 3.0  # bodies that can reach the height within +-3 sigma
+    assert free.sum() >= 8
+    np.testing.assert_allclose(heights[free], height_m, atol=2e-4)
+    assert np.all(np.abs(heights[~free] - height_m) > 2e-4)
+
+
+def test_unreachable_height_keeps_the_beta_limit(body_model):
+    conditioner = StatureConditioner(body_model, 20, 2.6, 3.0, [-10] * 4, [30] * 4)
+    betas = conditioner.complete(np.zeros((1, 19)), np.zeros((1, 4)))
+    assert abs(betas[0, 0]) == pytest.approx(3.0)
+
+
+def test_stature_scale_restores_the_stature(body_model):
+    rest, _ = rest_shape(body_model, np.full((1, 20), 0.3))
+    scale = stature_scale(rest[0], 1.8)
+    assert np.ptp(rest[0][:, 2] * scale) == pytest.approx(1.8)
+
+
+def test_conditioned_search_leaves_the_first_beta_out_of_the_genes():
+    conditioned, free = SearchSettings(), SearchSettings(condition_stature=False)
+    assert conditioned.lower.shape == (19 + 4,) and free.lower.shape == (20 + 4,)
+    np.testing.assert_array_equal(conditioned.upper[-4:], free.upper[-4:])
