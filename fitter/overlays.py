@@ -134,8 +134,18 @@ def _tinted_body(image: np.ndarray, labels: np.ndarray) -> None:
     image[inside] = np.round(_TINT * colours + (1 - _TINT) * image[inside]).astype(np.uint8)
 
 
+def _cropped(image: np.ndarray, margin_px: int = 16) -> np.ndarray:
+    """``image`` cut to its drawn (non-white) pixels plus a margin: the canvas leaves room
+    for every candidate of the search, mostly empty around the fitted one."""
+    rows, cols = np.nonzero((image < 255).any(axis=2))
+    top, left = max(0, rows.min() - margin_px), max(0, cols.min() - margin_px)
+    return image[top:rows.max() + margin_px + 1, left:cols.max() + margin_px + 1]
+
+
 def _with_legend(image: np.ndarray, title: str, entries: list[tuple[tuple, str]]) -> np.ndarray:
-    """``image`` under a title band, with the parts legend and ``entries`` to its right."""
+    """``image``, cropped, under a title band, with the parts legend and ``entries`` to
+    its right."""
+    image = _cropped(image)
     legend = parts_legend(20 + 24 * (len(PART_NAMES) + len(entries)))
     for i, (colour, text) in enumerate(entries):
         y = 20 + 24 * (len(PART_NAMES) + i)
