@@ -58,12 +58,16 @@ def _build_parser() -> argparse.ArgumentParser:
         description="Fit bodyfit's body model to a front photo (A-pose) and a side photo "
                     "(arms hanging down) on a plain backdrop. Cameras: the paper's "
                     "orthographic projection, each view scaled from the stature.")
-    run.add_argument("--front", required=True, metavar="PHOTO", help="front photo, A-pose")
-    run.add_argument("--side", required=True, metavar="PHOTO",
+    run.add_argument("--config", type=Path, metavar="run.json",
+                     help="repeat a previous run: its inputs and settings from its run.json "
+                          "(the options given here override them)")
+    run.add_argument("--front", metavar="PHOTO", help="front photo, A-pose (required "
+                     "without --config)")
+    run.add_argument("--side", metavar="PHOTO",
                      help="side photo (the person's left side), arms hanging down")
-    run.add_argument("--height-cm", required=True, type=float, metavar="CM",
+    run.add_argument("--height-cm", type=float, metavar="CM",
                      help="the person's stature, centimetres")
-    run.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
+    run.add_argument("-o", "--output", type=Path, metavar="OUT",
                      help="output folder (created; must be empty unless --overwrite)")
     run.add_argument("--camera", metavar="camera.json",
                      help="undistort the photos with this calibration (calib capture)")
@@ -73,29 +77,29 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--background-front", metavar="PHOTO",
                      help="background plate: the front view without the person")
     run.add_argument("--background-side", metavar="PHOTO", help="background plate, side view")
-    run.add_argument("--sex", choices=("female", "male", "unknown"), default="unknown",
+    run.add_argument("--sex", choices=("female", "male", "unknown"),
                      help="recorded with the run (default unknown)")
-    run.add_argument("--weights", default="paper", metavar="PRESET|FILE.toml",
+    run.add_argument("--weights", metavar="PRESET|FILE.toml",
                      help="cost weights: paper (Table 2, default), uniform, lower-body, "
                           "or a .toml file")
-    run.add_argument("--weight", action="append", default=[], metavar="NAME=VALUE",
+    run.add_argument("--weight", action="append", metavar="NAME=VALUE",
                      help="override one weight, e.g. waist=8 or view.side=3 (repeatable)")
-    run.add_argument("--matching", default="person_to_model",
+    run.add_argument("--matching",
                      help="boundary matching direction: person_to_model (the paper's, "
                           "default), model_to_person or symmetric")
-    run.add_argument("--optimizer", choices=("ga", "cmaes"), default="ga",
+    run.add_argument("--optimizer", choices=("ga", "cmaes"),
                      help="ga: the paper's genetic algorithm (default); cmaes: CMA-ES")
     run.add_argument("--population", type=int, help="candidates per generation "
                      "(default: ga 30, cmaes its own)")
     run.add_argument("--generations", type=int, help="generations (default: ga 25)")
-    run.add_argument("--components", type=int, default=20,
+    run.add_argument("--components", type=int,
                      help="shape components searched (default 20, as the paper; up to 60)")
-    run.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    run.add_argument("--free-stature", action="store_true",
+    run.add_argument("--seed", type=int, help="random seed (default 0)")
+    run.add_argument("--free-stature", action="store_true", default=None,
                      help="search the first shape component like the others (the paper) "
                           "instead of solving it so every candidate stands as tall as the "
                           "person")
-    run.add_argument("--device", default="cpu", help="cpu (default) or cuda:0")
+    run.add_argument("--device", help="cpu (default) or cuda:0")
     run.add_argument("--overwrite", action="store_true", help="write into a non-empty OUT")
 
     measure = sub.add_parser("measure", help="the 16 measurements (mm) of a mesh in the "
@@ -161,28 +165,65 @@ def _cmd_demo(args) -> None:
         print(f"  {path}")
 
 
-def _cmd_run(args) -> None:
+#: `fitter run`'s options that are fields of PersonInputs, and of SearchSettings.
+_INPUT_OPTIONS = ("front", "side", "height_cm", "camera", "mask_front", "mask_side",
+                  "background_front", "background_side", "sex")
+_SEARCH_OPTIONS = ("optimizer", "population", "generations", "components", "seed")
+
+
+def _run_settings(args):
+    """(PersonInputs, FitSettings, output folder) of `fitter run`'s options: the defaults,
+    or with --config the run.json's values, overridden by every option given."""
+    import dataclasses
+
     from bodyfit.fitter.fit import FitSettings
+    from bodyfit.fitter.person import PersonInputs
+    from bodyfit.fitter.run_config import read_run_config
+    from bodyfit.fitter.weights import (cost_settings, parse_override, settings_from_record,
+                                        weights_record)
+
+    given = {k: v for k, v in vars(args).items() if v is not None}
+    if args.config is None:
+        missing = [f"--{k.replace('_', '-')}" for k in ("front", "side", "height_cm")
+                   if k not in given] + ([] if args.output else ["-o"])
+        if missing:
+            raise UserError(f"fitter run needs {', '.join(missing)} (or --config run.json)")
+        inputs = PersonInputs(args.front, args.side, args.height_cm)
+        settings, output = FitSettings(), args.output
+    else:
+        config = read_run_config(args.config)
+        inputs, settings, output = config.inputs, config.settings, args.output or config.output
+        if output is None:
+            raise UserError(f"{args.config} records no output folder; give -o OUT")
+    inputs = dataclasses.replace(inputs, **{k: given[k] for k in _INPUT_OPTIONS if k in given})
+    search = dataclasses.replace(settings.search, **{k: given[k] for k in _SEARCH_OPTIONS
+                                                     if k in given})
+    if given.get("free_stature"):
+        search = dataclasses.replace(search, condition_stature=False)
+    cost = settings.cost
+    if "matching" in given:
+        cost = dataclasses.replace(cost, matching=args.matching)
+    if "weights" in given or "weight" in given:
+        if "weights" in given or args.config is None:
+            cost = cost_settings(given.get("weights", "paper"), given.get("weight", []), cost)
+        else:  # --weight on top of the recorded weights
+            record = weights_record(cost) | dict(map(parse_override, args.weight))
+            cost = settings_from_record(record, cost)
+    settings = dataclasses.replace(settings, search=search, cost=cost,
+                                   device=given.get("device", settings.device))
+    return inputs, settings, output
+
+
+def _cmd_run(args) -> None:
     from bodyfit.fitter.measurements import MEASUREMENTS
     from bodyfit.fitter.model_cache import load_model
-    from bodyfit.fitter.person import PersonInputs
     from bodyfit.fitter.run import run_person
-    from bodyfit.fitter.search import SearchSettings
-    from bodyfit.fitter.weights import cost_settings
-    from bodyfit.kernels import CostSettings
 
-    inputs = PersonInputs(args.front, args.side, args.height_cm, args.camera, args.mask_front,
-                          args.mask_side, args.background_front, args.background_side, args.sex)
-    inputs.validate()
     try:
-        settings = FitSettings(
-            search=SearchSettings(optimizer=args.optimizer, population=args.population,
-                                  generations=args.generations, components=args.components,
-                                  seed=args.seed, condition_stature=not args.free_stature),
-            cost=cost_settings(args.weights, args.weight, CostSettings(matching=args.matching)),
-            device=args.device)
+        inputs, settings, output = _run_settings(args)
+        inputs.validate()
         model = load_model()
-        fit, written = run_person(model, inputs, settings, args.output, args.overwrite,
+        fit, written = run_person(model, inputs, settings, output, args.overwrite,
                                   progress=None if not args.quiet else False)
     except ValueError as exc:  # the kernels' argument and device errors, --matching
         raise UserError(str(exc)) from None

@@ -6,13 +6,18 @@ Outputs, written atomically into OUT (a failed run leaves OUT as it was):
 - ``mesh_rest.ply``: the same body in the rest A-pose (where it is measured);
 - ``measurements.json`` / ``.csv``: the 16 measurements with their spreads, mm;
 - ``convergence.png``: the best and mean cost per generation;
-- ``run.json``: inputs, settings, weights, seed, versions, timings, best cost, parameters.
+- ``run.json``: inputs, settings, weights, seed, versions, timings, best cost, parameters,
+  the output folder and the working folder (``fitter run --config`` repeats the run);
+- ``overlay_front.png``, ``overlay_side.png``: the person's and the fitted body's
+  silhouettes with their matched contour points, coloured by part (the paper's Fig. 6/8);
+- ``report.html``: one self-contained page of all of it, for a person to read.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import importlib.metadata
+import os
 import platform
 from pathlib import Path
 
@@ -24,15 +29,20 @@ from bodyfit.calib.images import write_image
 from bodyfit.fitter.body_model import POSE_NAMES, BodyModel
 from bodyfit.fitter.fit import Fit, FitSettings, fit_person
 from bodyfit.fitter.mesh_io import write_mesh
-from bodyfit.fitter.outputs import staged_directory, write_fitted_measurements, write_json
+from bodyfit.fitter.outputs import (staged_directory, write_fitted_measurements, write_json,
+                                    write_text)
+from bodyfit.fitter.overlays import fitted_outline_image, match_contours, overlay_image
 from bodyfit.fitter.person import PersonInputs, person_masks
 from bodyfit.fitter.plots import line_chart
+from bodyfit.fitter.report import report_html
+from bodyfit.fitter.weights import weights_record
 
 __all__ = ["RUN_FILES", "check_output_dir", "run_person", "run_record"]
 
 #: The files every successful run writes into OUT.
 RUN_FILES = ("mesh.obj", "mesh.ply", "mesh_rest.ply", "measurements.json", "measurements.csv",
-             "convergence.png", "run.json")
+             "convergence.png", "run.json", "overlay_front.png", "overlay_side.png",
+             "report.html")
 
 
 def check_output_dir(out_dir: Path, overwrite: bool) -> None:
@@ -54,11 +64,15 @@ def _versions() -> dict[str, str]:
     return found | {"python": platform.python_version()}
 
 
-def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fit: Fit) -> dict:
-    """The run.json payload: everything needed to repeat and judge the run."""
+def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fit: Fit,
+               out_dir: Path) -> dict:
+    """The run.json payload: everything needed to repeat and judge the run (relative
+    input paths are relative to ``working_dir``)."""
     result = fit.search
     return {
         "inputs": dataclasses.asdict(inputs),
+        "output": str(out_dir),
+        "working_dir": os.getcwd(),
         "settings": dataclasses.asdict(settings),
         "cost_terms": list(kernels.TERM_NAMES),
         "model": {"settings": model.metadata.get("settings"),
@@ -101,5 +115,14 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
                                   {"command": "fitter run", "front": inputs.front,
                                    "side": inputs.side, "height_cm": inputs.height_cm})
         write_image(stage / "convergence.png", chart)
-        write_json(stage / "run.json", run_record(inputs, settings, model, fit))
+        record = run_record(inputs, settings, model, fit, out_dir)
+        write_json(stage / "run.json", record)
+        pictures = {"convergence": chart}
+        for name, view in fit.views.items():
+            matched = match_contours(model, fit.posed, view, settings.device)
+            pictures[f"overlay_{name}"] = overlay_image(matched)
+            pictures[f"outline_{name}"] = fitted_outline_image(matched)
+            write_image(stage / f"overlay_{name}.png", pictures[f"overlay_{name}"])
+        write_text(stage / "report.html", report_html(record, weights_record(settings.cost),
+                                                      fit.measurements, fit.spreads, pictures))
     return fit, [out_dir / name for name in RUN_FILES]

@@ -39,6 +39,7 @@ def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, cap
     code, stdout, err = run(capsys, "run", *person_args(folder, truth), "-o", str(out), *BUDGET)
     assert code == 0, err
     assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES)
+    assert {"overlay_front.png", "overlay_side.png", "report.html"} <= set(RUN_FILES)
     assert "chest circumference" in stdout and str(out / "mesh.obj") in stdout
     table = json.loads((out / "measurements.json").read_text())["measurements"]
     assert len(table) == 16 and table["stature"]["letter"] == "O"

@@ -1,0 +1,164 @@
+"""`fitter run`'s overlays and report.html, and repeating a run with --config run.json."""
+
+import dataclasses
+import html
+import html.parser
+import json
+import re
+import shutil
+
+import cv2
+import numpy as np
+import pytest
+
+from bodyfit.fitter.cli import main
+from bodyfit.fitter.body_model import PART_NAMES
+from bodyfit.fitter.fit import FitSettings
+from bodyfit.fitter.measurements import MEASUREMENTS
+from bodyfit.fitter.person import PersonInputs
+from bodyfit.fitter.render import PART_COLOURS_BGR
+from bodyfit.fitter.run_config import read_run_config, run_config
+from bodyfit.fitter.search import SearchSettings
+from bodyfit.fitter.studio_photos import write_subject
+from bodyfit.kernels import CostSettings
+
+BETAS = np.r_[0.5, np.zeros(19)]
+POSE = np.array([5.0, 5.0, 3.0, 3.0])
+BUDGET = ["--optimizer", "ga", "--population", "10", "--generations", "2", "--seed", "5",
+          "--weight", "waist=7"]
+
+
+class _Page(html.parser.HTMLParser):
+    """Collects the tags, the <img> sources and every URL-valued attribute of a page."""
+
+    def __init__(self):
+        super().__init__()
+        self.images, self.urls, self.tags = [], [], []
+
+    def handle_starttag(self, tag, attrs):
+        self.tags.append(tag)
+        for name, value in attrs:
+            if name in ("src", "href", "srcset", "action"):
+                self.urls.append(value)
+            if tag == "img" and name == "src":
+                self.images.append(value)
+
+
+@pytest.fixture(scope="module")
+def first_run(body_model, tmp_path_factory):
+    """One small run on photos in a folder named with markup; its output folder."""
+    folder = tmp_path_factory.mktemp("photos") / "<script>alert(1)"
+    folder.mkdir()
+    truth = write_subject(folder, body_model, BETAS, POSE)
+    out = tmp_path_factory.mktemp("runs") / "first"
+    code = main(["-q", "run", "--front", str(folder / "front.png"), "--side",
+                 str(folder / "side.png"), "--height-cm", f"{truth['O'] / 10:.2f}",
+                 "-o", str(out), *BUDGET])
+    assert code == 0
+    return out
+
+
+@pytest.mark.parametrize("view", ["front", "side"])
+def test_overlays_show_both_silhouettes_and_part_coloured_pairs(first_run, view):
+    image = cv2.imread(str(first_run / f"overlay_{view}.png"))
+    # twice the canvas, cropped to the bodies (about 400 px tall there) with 16 px around,
+    # under a 30 px title band
+    assert abs(image.shape[0] - (2 * 400 + 2 * 16 + 30)) <= 2 * 15
+    drawing = image[30:, :-120]  # the legend is the last 120 columns
+    counts = {name: int((drawing == colour).all(axis=2).sum())
+              for name, colour in zip(PART_NAMES, PART_COLOURS_BGR)}
+    assert all(counts[name] > 20 for name in ("head", "chest", "waist", "hip", "leg", "foot"))
+    assert (counts["arm"] > 20) == (view == "front")  # the side view is fitted without arms
+    assert (drawing == (212, 212, 212)).all(axis=2).sum() > 100  # the person's silhouette
+
+
+def test_report_is_one_self_contained_escaped_page(first_run):
+    text = (first_run / "report.html").read_text()
+    page = _Page()
+    page.feed(text)
+    page.close()
+    assert len(page.images) == 5  # two outlines, two overlays, convergence
+    assert all(src.startswith("data:image/png;base64,") for src in page.images)
+    assert all(url.startswith("data:") for url in page.urls)
+    assert "http://" not in text and "https://" not in text and "script" not in page.tags
+    assert "&lt;script&gt;alert(1)" in text and "<script>" not in text
+    values = json.loads((first_run / "measurements.json").read_text())["measurements"]
+    for key, (name, label) in MEASUREMENTS.items():
+        row = re.search(rf"<td>{key}</td><td>{re.escape(html.escape(label))}</td>"
+                        r'<td class="num">([\d.]+)</td><td class="num">± ([\d.]+)</td>', text)
+        assert row, label
+        assert float(row[1]) == pytest.approx(values[name]["value_mm"], abs=0.051)
+        assert float(row[2]) == pytest.approx(values[name]["spread_mm"], abs=0.051)
+    assert '<th>waist</th><td class="num">7</td>' in text
+    assert "<th>optimizer</th><td>ga</td>" in text and "<th>seed</th><td>5</td>" in text
+
+
+def test_run_json_round_trips_into_the_same_settings(first_run):
+    config = read_run_config(first_run / "run.json")
+    assert config.settings == FitSettings(
+        search=SearchSettings(optimizer="ga", population=10, generations=2, seed=5),
+        cost=CostSettings(part_weights=(2.0, 5.0, 7.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0)))
+    assert config.inputs.front.endswith("front.png") and config.output == first_run
+    custom = FitSettings(search=SearchSettings(pose_lower_deg=(-5.0,) * 4, components=12),
+                         cost=CostSettings(matching="symmetric", align_rotation=False),
+                         device="cuda:0")
+    inputs = PersonInputs("/a/f.png", "/a/s.png", 171.5, mask_side="/a/m.png", sex="female")
+    record = json.loads(json.dumps({"inputs": dataclasses.asdict(inputs),
+                                    "settings": dataclasses.asdict(custom)}))
+    again = run_config(record)
+    assert again.settings == custom and again.inputs == inputs and again.output is None
+
+
+def test_config_repeats_the_run_and_options_override_it(first_run, tmp_path, capsys):
+    first = json.loads((first_run / "run.json").read_text())
+    same, other = tmp_path / "same", tmp_path / "other"
+    assert main(["-q", "run", "--config", str(first_run / "run.json"), "-o", str(same)]) == 0
+    assert main(["-q", "run", "--config", str(first_run / "run.json"), "-o", str(other),
+                 "--seed", "6"]) == 0
+    capsys.readouterr()
+    repeated = json.loads((same / "run.json").read_text())
+    assert repeated["result"]["best_cost"] == first["result"]["best_cost"]
+    assert repeated["result"]["betas"] == first["result"]["betas"]
+    assert repeated["settings"] == first["settings"]
+    changed = json.loads((other / "run.json").read_text())
+    assert changed["settings"]["search"]["seed"] == 6
+    assert changed["result"]["betas"] != first["result"]["betas"]
+
+
+def test_config_into_its_own_folder_needs_overwrite(first_run, tmp_path, capsys):
+    copy = tmp_path / "copy"
+    shutil.copytree(first_run, copy)
+    record = json.loads((copy / "run.json").read_text()) | {"output": str(copy)}
+    (copy / "run.json").write_text(json.dumps(record))
+    assert main(["-q", "run", "--config", str(copy / "run.json")]) == 2
+    assert "--overwrite" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("content,message", [
+    (None, "no such file"),
+    ("{", "not JSON"),
+    ("[1]", "object"),
+    ('{"inputs": {}}', "missing 'settings'"),
+    ('{"inputs": {"front": "f.png"}, "settings": {}}', "missing 'side'"),
+    ('{"inputs": {"front": "f", "side": "s", "height_cm": 170}, '
+     '"settings": {"search": {"components": "twenty"}}}', "components"),
+    ('{"inputs": {"front": "f", "side": "s", "height_cm": 170}, '
+     '"settings": {"cost": {"matching": "both"}}}', "matching"),
+    ('{"inputs": {"front": "f", "side": "s", "height_cm": 170, "age": 3}, "settings": {}}',
+     "unknown field 'age'"),
+])
+def test_bad_config_is_one_line(tmp_path, capsys, content, message):
+    path = tmp_path / "run.json"
+    if content is not None:
+        path.write_text(content)
+    assert main(["-q", "run", "--config", str(path), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("fitter: error:") and len(err.strip().splitlines()) == 1
+    assert message in err, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_without_config_the_person_is_required(capsys):
+    assert main(["-q", "run", "--front", "f.png", "-o", "out"]) == 2
+    err = capsys.readouterr().err
+    assert "--side, --height-cm" in err and "--config" in err
