@@ -83,6 +83,10 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--matching", default="person_to_model",
                      help="boundary matching direction: person_to_model (the paper's, "
                           "default), model_to_person or symmetric")
+    run.add_argument("--side-arms", choices=("down", "hidden"), default="down",
+                     help="the side view's candidates: down (default) with their arms "
+                          "hanging down, as the side photo shows them; hidden: without arms "
+                          "(for a side photo whose arms hide within the torso)")
     run.add_argument("--optimizer", choices=("ga", "cmaes"), default="ga",
                      help="ga: the paper's genetic algorithm (default); cmaes: CMA-ES")
     run.add_argument("--population", type=int, help="candidates per generation "
@@ -176,7 +180,7 @@ def _cmd_run(args) -> None:
                                   generations=args.generations, components=args.components,
                                   seed=args.seed),
             cost=cost_settings(args.weights, args.weight, CostSettings(matching=args.matching)),
-            device=args.device)
+            device=args.device, side_arms=args.side_arms)
         model = load_model()
         fit, written = run_person(model, inputs, settings, args.output, args.overwrite,
                                   progress=None if not args.quiet else False)
