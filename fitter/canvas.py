@@ -96,7 +96,7 @@ def scaled_person(mask: np.ndarray, scale: float) -> np.ndarray:
 
 def orthographic_view(name: str, mask: np.ndarray, stature_m: float, extent: np.ndarray,
                       mean_body: np.ndarray, settings: CanvasSettings = CanvasSettings(),
-                      device: str = "cpu") -> kernels.ViewTarget:
+                      device: str = "cpu", **view_options) -> kernels.ViewTarget:
     """One view of the person on a canvas with the paper's orthographic camera.
 
     Args:
@@ -107,6 +107,9 @@ def orthographic_view(name: str, mask: np.ndarray, stature_m: float, extent: np.
         mean_body: (V, 3) float32 metres, the mean body in its default pose.
         settings: canvas geometry.
         device: where the kernels run.
+        view_options: ``visible_parts`` (default ``VIEW_PARTS[name]``) and
+            ``fixed_pose_deg`` of ``kernels.prepare_view_target`` (the side view's arms,
+            :func:`bodyfit.fitter.side_arms.side_view_options`).
 
     Returns:
         The kernels' target; its camera renders candidates at the person's scale.
@@ -128,5 +131,6 @@ def orthographic_view(name: str, mask: np.ndarray, stature_m: float, extent: np.
     canvas = np.zeros((height, width), bool)
     top, left = np.round(centre - low - half).astype(int)[::-1]
     canvas[top:top + person.shape[0], left:left + person.shape[1]] = person
+    view_options = {"visible_parts": VIEW_PARTS[name]} | view_options
     return kernels.prepare_view_target(name, canvas, camera, 1000.0 / pixels_per_metre,
-                                       visible_parts=VIEW_PARTS[name], device=device)
+                                       device=device, **view_options)

@@ -87,6 +87,10 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--matching",
                      help="boundary matching direction: person_to_model (the paper's, "
                           "default), model_to_person or symmetric")
+    run.add_argument("--side-arms", choices=("down", "hidden"),
+                     help="the side view's candidates: down (default) with their arms "
+                          "hanging down, as the side photo shows them; hidden: without arms "
+                          "(for a side photo whose arms hide within the torso)")
     run.add_argument("--optimizer", choices=("ga", "cmaes"),
                      help="ga: the paper's genetic algorithm (default); cmaes: CMA-ES")
     run.add_argument("--population", type=int, help="candidates per generation "
@@ -210,7 +214,8 @@ def _run_settings(args):
             record = weights_record(cost) | dict(map(parse_override, args.weight))
             cost = settings_from_record(record, cost)
     settings = dataclasses.replace(settings, search=search, cost=cost,
-                                   device=given.get("device", settings.device))
+                                   device=given.get("device", settings.device),
+                                   side_arms=given.get("side_arms", settings.side_arms))
     return inputs, settings, output
 
 

@@ -20,6 +20,7 @@ from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import CanvasSettings, model_extent, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
+from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, stature_scale
 
 __all__ = ["FitSettings", "Fit", "fit_person"]
@@ -37,12 +38,16 @@ class FitSettings:
         canvas: canvas geometry.
         cost: the kernels' weights and matching (the paper's Table 2 by default).
         device: where the kernels run, "cpu" or "cuda:0".
+        side_arms: how the side view treats the person's arms, one of
+            ``bodyfit.fitter.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
+            arms hanging down; "hidden": without arms).
     """
 
     search: SearchSettings = SearchSettings()
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = kernels.CostSettings()
     device: str = "cpu"
+    side_arms: str = "down"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -102,8 +107,11 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     extent = model_extent(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
                           settings.canvas.beta_limit)
     mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
+    # arms turned down in the frontal plane keep their side-view width and stay above
+    # the feet, so the extent of the search's pose range covers them
+    options = {"front": {}, "side": side_view_options(model, settings.side_arms)}
     views = {name: orthographic_view(name, masks[name], stature_m, extent, mean_body,
-                                     settings.canvas, settings.device)
+                                     settings.canvas, settings.device, **options[name])
              for name in ("front", "side")}
     arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)

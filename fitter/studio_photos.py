@@ -5,10 +5,16 @@ measurements are known, photographed so that ``fitter run`` can be checked again
 
 Painted by :func:`bodyfit.fitter.render.render_parts` (OpenCV polygons far to near), not
 by the kernels, on a plain backdrop. The paper's orthographic projection: the body is
-scaled to ``body_px`` pixels tall. The side photo shows the body's left side (facing the
-image's left, as a camera at the person's left sees it) without the arms: the model's
-four pose angles cannot hang the arms down against the body, so this scene stands for a
-side photo whose arms hide within the torso's profile.
+scaled to ``body_px`` pixels tall. The front photo shows the body in its pose (an
+A-pose). The side photo shows the body's left side (facing the image's left, as a camera
+at the person's left sees it), with ``side_arms``:
+
+- ``"down"`` (default, as users photograph it): the arms hang straight down, the
+  shoulders at the body's own arms-down angle
+  (:func:`bodyfit.fitter.side_arms.side_photo_pose`), rendered with the arms, which show
+  in front of and beside the torso's profile;
+- ``"hidden"``: the body in the front photo's pose without arm, elbow and hand: a side
+  photo whose arms hide within the torso's profile.
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ import numpy as np
 from bodyfit.fitter.body_model import PART_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.render import render_parts
+from bodyfit.fitter.side_arms import side_photo_pose
 
 BACKDROP_BGR = (170, 185, 200)
 SIDE_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
@@ -41,14 +48,31 @@ def photo(vertices, model, view: str, parts, body_px: int = 700,
     return canvas
 
 
-__all__ = ["photo", "write_subject"]
+__all__ = ["SIDE_ARMS", "photo", "write_subject"]
 
 
-def write_subject(folder, model, betas, pose_deg) -> dict[str, float]:
+SIDE_ARMS = ("down", "hidden")
+
+
+def write_subject(folder, model, betas, pose_deg, side_arms: str = "down") -> dict[str, float]:
     """Write front.png and side.png of one body into ``folder``; return its true
-    measurements (key -> mm) of the rest body."""
+    measurements (key -> mm) of the rest body.
+
+    Args:
+        folder: an existing folder (``pathlib.Path``).
+        betas: (K,) shape coefficients, sigma.
+        pose_deg: (4,) front photo's abduction angles, degrees, ``POSE_NAMES`` order.
+        side_arms: ``"down"`` or ``"hidden"`` (module docstring).
+    """
+    if side_arms not in SIDE_ARMS:
+        raise ValueError(f"side_arms must be one of {SIDE_ARMS}, got {side_arms!r}")
     betas, pose_deg = np.atleast_2d(betas), np.atleast_2d(pose_deg)
     posed = forward(model, betas, pose_deg)[0]
     cv2.imwrite(str(folder / "front.png"), photo(posed, model, "front", PART_NAMES))
-    cv2.imwrite(str(folder / "side.png"), photo(posed, model, "side", SIDE_PARTS))
+    if side_arms == "down":
+        side_pose = side_photo_pose(model, betas[0], pose_deg[0])[None]
+        side = photo(forward(model, betas, side_pose)[0], model, "side", PART_NAMES)
+    else:
+        side = photo(posed, model, "side", SIDE_PARTS)
+    cv2.imwrite(str(folder / "side.png"), side)
     return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])

@@ -5,8 +5,9 @@
     evaluator = PopulationEvaluator(model, views, CostSettings())
     costs, part_costs = evaluator.evaluate(betas, pose_deg)     # every generation
 
-For each chunk of candidates: skin once; then per view: project, rasterise into label
-maps, row-scan the boundaries, align to the person, match the boundaries, and add the
+For each chunk of candidates: skin once per distinct view pose (once, unless a view fixes
+some pose angles, ``ViewTarget.fixed_pose_deg``, e.g. a side view with the arms down);
+then per view: project, rasterise into label maps, row-scan the boundaries, align to the person, match the boundaries, and add the
 view's weighted terms. The optimiser never sees the kernels: it asks for a population,
 the caller evaluates it here, and tells the optimiser the costs.
 """
@@ -131,6 +132,8 @@ class PopulationEvaluator:
         self.profile = profile
         self.stage_seconds = dict.fromkeys(STAGES, 0.0)
         self._views = [_ViewState(v, model, settings) for v in views]
+        #: the distinct ``fixed_pose_deg`` of the views: one skinning per chunk each
+        self._view_poses = list(dict.fromkeys(v.fixed_pose_deg for v in views))
         self._capacity = 0
         self._timer = time.perf_counter if model.device.is_cuda else time.process_time
         self._clock = 0.0
@@ -142,7 +145,9 @@ class PopulationEvaluator:
             state.allocate(capacity)
         self._joints = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.vec3, device=dev)
         self._rotations = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.mat33, device=dev)
-        self._vertices = wp.empty((capacity, self.model.num_vertices), dtype=wp.vec3, device=dev)
+        self._vertices = {fixed: wp.empty((capacity, self.model.num_vertices), dtype=wp.vec3,
+                                          device=dev)
+                          for fixed in self._view_poses}
         self._term_costs = wp.empty((capacity, len(TERM_NAMES)), dtype=wp.float32, device=dev)
         self._costs = wp.empty(capacity, dtype=wp.float32, device=dev)
         self._capacity = capacity
@@ -150,6 +155,7 @@ class PopulationEvaluator:
     def buffer_bytes(self) -> int:
         """Bytes of device memory held by this evaluator (model data excluded)."""
         arrays = [v for v in vars(self).values() if isinstance(v, wp.array)]
+        arrays += list(getattr(self, "_vertices", {}).values())
         arrays += [a for state in self._views for a in state.arrays()]
         return sum(a.capacity for a in arrays)
 
@@ -178,26 +184,29 @@ class PopulationEvaluator:
         total = dims["P"]
         if min(total, self.chunk_size) > self._capacity:
             self._allocate(min(total, self.chunk_size))
+        poses = {fixed: _fixed_angles(pose_deg, fixed) for fixed in self._view_poses}
         costs = np.empty(total, np.float32)
         part_costs = np.empty((total, len(TERM_NAMES)), np.float32)
         for start in range(0, total, self.chunk_size):
             stop = min(start + self.chunk_size, total)
             costs[start:stop], part_costs[start:stop] = self._evaluate_chunk(
-                betas[start:stop], pose_deg[start:stop])
+                betas[start:stop], {fixed: pose[start:stop] for fixed, pose in poses.items()})
         return PopulationCost(costs, part_costs)
 
-    def _evaluate_chunk(self, betas: wp.array, pose_deg: wp.array):
+    def _evaluate_chunk(self, betas: wp.array, poses: dict[tuple, wp.array]):
         num = betas.shape[0]
         self._clock = self._timer()
-        vertices = self._vertices[:num]
-        launch_skinning(self.model, betas, pose_deg, self._joints[:num], self._rotations[:num],
-                        vertices)
         term_costs, costs = self._term_costs[:num], self._costs[:num]
         term_costs.zero_()
         costs.zero_()
-        self._stage_done("skin")
-        for state in self._views:
-            self._evaluate_view(state, vertices, term_costs, costs)
+        for fixed, pose_deg in poses.items():
+            vertices = self._vertices[fixed][:num]
+            launch_skinning(self.model, betas, pose_deg, self._joints[:num],
+                            self._rotations[:num], vertices)
+            self._stage_done("skin")
+            for state in self._views:
+                if state.view.fixed_pose_deg == fixed:
+                    self._evaluate_view(state, vertices, term_costs, costs)
         out = costs.numpy(), term_costs.numpy()
         self._stage_done("cost")
         return out
@@ -226,6 +235,17 @@ class PopulationEvaluator:
         launch_view_cost(state.params, state.moments, distances, parts, row_sums, row_pixels,
                          transforms, extremes, areas, term_costs, costs)
         self._stage_done("cost")
+
+
+def _fixed_angles(pose_deg: wp.array, fixed: tuple[tuple[int, float], ...]) -> wp.array:
+    """(P, 4) float32 degrees: ``pose_deg`` with the angles of ``fixed``
+    (``ViewTarget.fixed_pose_deg``) put in; ``pose_deg`` itself when there are none."""
+    if not fixed:
+        return pose_deg
+    pose = pose_deg.numpy().copy()  # on a CPU device .numpy() shares the memory
+    for column, degrees in fixed:
+        pose[:, column] = degrees
+    return wp.array(pose, dtype=wp.float32, device=pose_deg.device)
 
 
 def evaluate_population(model: ModelArrays, views: Sequence[ViewTarget], betas, pose_deg,

@@ -172,10 +172,14 @@ def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) 
 def population_cost(model: SkinnableModel, betas: np.ndarray, pose_deg: np.ndarray,
                     views: list[ViewTarget], settings: CostSettings = CostSettings(),
                     supersample: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """The reference pipeline: costs (P,) and part costs (P, 11), float64, millimetres."""
-    vertices = skin_reference(model, betas, pose_deg)
+    """The reference pipeline: costs (P,) and part costs (P, 11), float64, millimetres.
+
+    Each view skins the candidates with its own pose (``ViewTarget.view_pose``: the
+    candidates' angles, with the view's fixed angles put in).
+    """
     part_costs = np.zeros((len(betas), len(TERM_NAMES)))
     for view in views:
+        vertices = skin_reference(model, betas, view.view_pose(pose_deg))
         faces, face_parts = visible_faces(model.faces, model.face_parts, view.visible_parts)
         screen = project_vertices(view.camera, vertices)
         maps = render_label_maps(screen, faces, face_parts, view.height, view.width,

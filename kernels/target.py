@@ -11,13 +11,14 @@ OpenCV and SciPy; the results go to the device once.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import cv2
 import numpy as np
 import scipy.ndimage as ndi
 import warp as wp
 
-from bodyfit.kernels.body_layout import PART_NAMES
+from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES
 from bodyfit.kernels.alignment import SilhouetteMoments, silhouette_moments
 from bodyfit.kernels.view_camera import ViewCamera
 from bodyfit.kernels.device import resolve_device
@@ -27,9 +28,10 @@ __all__ = ["VIEW_NAMES", "SIDE_VIEW_PARTS", "ViewTarget", "prepare_view_target",
 
 #: The two views of the paper, in the order their weights appear in Table 2.
 VIEW_NAMES = ("front", "side")
-#: Parts rendered in the side view: the paper's side photo is taken with the hands against
-#: the body, so no arm silhouette appears there, while the model's A-pose arms hang forward
-#: (and its four pose angles cannot swing them back): arm, elbow and hand are left out.
+#: Parts rendered in a side view whose arms are left out (the paper's side photo is taken
+#: with the hands against the body, so no arm silhouette appears there): arm, elbow and
+#: hand are left out. The other way is to render every part with the arms posed down, see
+#: ``prepare_view_target(fixed_pose_deg=...)``.
 SIDE_VIEW_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
 
 def visible_faces(faces: np.ndarray, face_parts: np.ndarray,
@@ -80,6 +82,9 @@ class ViewTarget:
         boundary_distance: (H, W) float32 Warp array, pixels, exact EDT of that boundary.
         moments: the person's silhouette moments (centroid, orientation, top/bottom points).
         silhouette: (H, W) bool, the person's mask (host copy, for references and overlays).
+        fixed_pose_deg: ((pose column, degrees), ...) sorted by column: pose angles this
+            view renders every candidate with in place of the candidate's own (e.g. the
+            shoulders at the arms-down angle of a side photo); empty: the candidate's pose.
     """
 
     name: str
@@ -92,10 +97,39 @@ class ViewTarget:
     boundary_distance: wp.array
     moments: SilhouetteMoments
     silhouette: np.ndarray
+    fixed_pose_deg: tuple[tuple[int, float], ...] = ()
+
+    def view_pose(self, pose_deg: np.ndarray) -> np.ndarray:
+        """(P, 4) float pose this view renders for candidate poses (P, 4) degrees
+        (``POSE_NAMES`` order): a copy with the fixed angles put in."""
+        pose = np.array(pose_deg, copy=True)
+        for column, degrees in self.fixed_pose_deg:
+            pose[:, column] = degrees
+        return pose
+
+
+def _fixed_pose(fixed_pose_deg) -> tuple[tuple[int, float], ...]:
+    """Checked ``{pose name: degrees}`` as ``ViewTarget.fixed_pose_deg``."""
+    fixed = dict(fixed_pose_deg or {})
+    unknown = set(fixed) - set(POSE_NAMES)
+    if unknown:
+        raise ValueError(f"fixed_pose_deg names must be in {POSE_NAMES}, got {sorted(unknown)}")
+    checked = []
+    for name, degrees in fixed.items():
+        try:
+            value = float(degrees)
+        except (TypeError, ValueError):
+            value = math.nan
+        if not -180.0 <= value <= 180.0:
+            raise ValueError(f"fixed_pose_deg[{name!r}] must be a number of degrees in "
+                             f"[-180, 180], got {degrees!r}")
+        checked.append((POSE_NAMES.index(name), value))
+    return tuple(sorted(checked))
 
 
 def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pixel: float,
-                        visible_parts=PART_NAMES, device: str = "cpu") -> ViewTarget:
+                        visible_parts=PART_NAMES, device: str = "cpu",
+                        fixed_pose_deg=None) -> ViewTarget:
     """Prepare the person's silhouette of one view (boundary, distance transform, moments).
 
     Args:
@@ -106,10 +140,13 @@ def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pix
         millimetres_per_pixel: > 0, image scale at the person.
         visible_parts: names from ``PART_NAMES`` rendered in this view.
         device: where the kernels run.
+        fixed_pose_deg: ``{name in POSE_NAMES: degrees}``, angles every candidate is
+            rendered with in this view in place of its own (None: its own pose).
 
     Raises:
-        ValueError: an unknown view or part name, a mask that is not 2D bool (or 0/1), an
-            empty mask, a size outside [1, 4096], or a non-positive scale.
+        ValueError: an unknown view, part or pose name, a mask that is not 2D bool (or
+            0/1), an empty mask, a size outside [1, 4096], a non-positive scale, or a
+            fixed angle that is not a finite number in [-180, 180].
     """
     if name not in VIEW_NAMES:
         raise ValueError(f"name must be one of {VIEW_NAMES}, got {name!r}")
@@ -128,6 +165,7 @@ def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pix
         raise ValueError("mask is empty: the person's silhouette has no pixel")
     if not millimetres_per_pixel > 0:
         raise ValueError("millimetres_per_pixel must be > 0")
+    fixed_pose = _fixed_pose(fixed_pose_deg)
     dev = resolve_device(device)
     mask = mask.astype(bool)
     boundary = boundary_mask(mask)
@@ -140,4 +178,5 @@ def prepare_view_target(name: str, mask, camera: ViewCamera, millimetres_per_pix
         boundary_points=wp.array(points, dtype=wp.vec2, device=dev),
         boundary_distance=wp.array(boundary_distance(boundary), dtype=wp.float32, device=dev),
         moments=silhouette_moments(mask),
-        silhouette=mask)
+        silhouette=mask,
+        fixed_pose_deg=fixed_pose)

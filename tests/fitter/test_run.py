@@ -48,6 +48,7 @@ def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, cap
     assert abs(table["stature"]["value_mm"] - truth["O"]) < 15.0
     record = json.loads((out / "run.json").read_text())
     assert record["settings"]["search"]["optimizer"] == "cmaes"
+    assert record["settings"]["side_arms"] == "down"
     assert record["result"]["evaluations"] == 24 * 30
     costs = record["result"]["best_cost_per_generation"]
     assert costs[-1] < costs[0] and all(np.diff(costs) <= 0)
@@ -90,6 +91,7 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--optimizer": "sgd"}, "invalid choice"),
     ({"--components": "99"}, "components"),
     ({"--matching": "both"}, "matching"),
+    ({"--side-arms": "up"}, "invalid choice"),
     ({"swap": True}, "swapped"),
     ({"blank": True}, "no person"),
 ])

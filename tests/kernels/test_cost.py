@@ -5,16 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bodyfit.fitter.body_model import PART_NAMES
-from bodyfit.kernels.view_camera import orthographic_camera
+from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES
+from bodyfit.kernels.view_camera import SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
 from bodyfit.kernels.evaluator import PopulationEvaluator, evaluate_population
 from bodyfit.kernels.reference import population_cost, view_terms
 from bodyfit.kernels.skinning import ModelArrays
 from bodyfit.kernels.target import SIDE_VIEW_PARTS, prepare_view_target
 
-from kernel_scenes import (DEVICES, FRONT_WIDTH, PIXELS_PER_METRE, SIDE_WIDTH, front_camera,
-                           random_bodies, render_labels, side_camera)
+from kernel_scenes import (DEVICES, FRONT_WIDTH, HEIGHT, PIXELS_PER_METRE, SIDE_WIDTH,
+                           front_camera, random_bodies, render_labels, side_camera)
 
 MM_PER_PX = 1000.0 / PIXELS_PER_METRE
 
@@ -94,6 +94,52 @@ def test_side_view_leaves_out_arms_held_against_the_body(body_model, model_array
         assert artefact.sum() > 300.0 and artefact[TERM_NAMES.index("chest")] > 20.0
 
 
+#: Both shoulders at the arms-down angle (about -41 degrees hangs the mean body's arms down).
+ARMS_DOWN = {POSE_NAMES[0]: -40.0, POSE_NAMES[1]: -40.0}
+
+
+#: Side canvas width for the arms down: the forearms hang forward beyond SIDE_WIDTH.
+ARMS_DOWN_WIDTH = 320
+
+
+def _arms_down(pose):
+    pose = np.array(pose, copy=True)
+    pose[:, :2] = -40.0
+    return pose
+
+
+def test_view_with_fixed_shoulders_skins_like_the_numpy_forward_in_that_pose(
+        body_model, model_arrays, views, truth, candidates):
+    """A side photo with the arms hanging down, every part visible: the side view renders
+    each candidate with its shoulders at the fixed angle (its own pose in the front view),
+    equal to the NumPy forward of that pose drawn by the same rasteriser."""
+    camera = orthographic_camera(SIDE_VIEW_DEG, PIXELS_PER_METRE,
+                                 (ARMS_DOWN_WIDTH / 2, HEIGHT / 2))
+    person = render_labels(body_model, truth[0], _arms_down(truth[1]), camera,
+                           ARMS_DOWN_WIDTH)[0] >= 0
+    assert not (person[:, [0, -1]].any() or person[[0, -1]].any())  # not cut by the canvas
+    side = prepare_view_target("side", person, camera, MM_PER_PX, PART_NAMES,
+                               fixed_pose_deg=ARMS_DOWN)
+    both = [views[0], side]
+    settings = CostSettings()
+    costs = evaluate_population(model_arrays, both, *candidates, settings).costs
+    betas, pose = candidates
+    expected = np.stack([view_terms(m, views[0], settings) for m in render_labels(
+        body_model, betas, pose, front_camera(), FRONT_WIDTH, views[0].visible_parts)])
+    expected += np.stack([view_terms(m, side, settings) for m in render_labels(
+        body_model, betas, _arms_down(pose), camera, ARMS_DOWN_WIDTH)])
+    assert np.allclose(costs, expected.sum(axis=1), rtol=1e-4, atol=1e-2)
+    assert costs[0] < 1e-3 and (costs[1:] > 100).all()
+    # without the fixed angles the true body's A-pose arms miss the person's
+    own_pose = prepare_view_target("side", person, camera, MM_PER_PX, PART_NAMES)
+    assert evaluate_population(model_arrays, [views[0], own_pose], *truth).costs[0] > 100
+    # the side view ignores the candidates' shoulder angles
+    turned = pose.copy()
+    turned[:, :2] += 15.0
+    assert np.array_equal(evaluate_population(model_arrays, [side], betas, pose).costs,
+                          evaluate_population(model_arrays, [side], betas, turned).costs)
+
+
 def test_chunks_do_not_change_the_costs(model_arrays, views, candidates):
     whole = PopulationEvaluator(model_arrays, views, chunk_size=8).evaluate(*candidates)
     chunked = PopulationEvaluator(model_arrays, views, chunk_size=2).evaluate(*candidates)
@@ -139,6 +185,9 @@ def test_settings_reject_bad_values(kwargs, message):
     (dict(mask=np.ones((2, 4, 4), bool)), r"mask must be a \(H, W\) bool array"),
     (dict(visible_parts=("tail",)), "visible_parts must be a non-empty subset"),
     (dict(millimetres_per_pixel=0.0), "millimetres_per_pixel must be > 0"),
+    (dict(fixed_pose_deg={"knee": 3.0}), "fixed_pose_deg names must be in"),
+    (dict(fixed_pose_deg={POSE_NAMES[0]: float("nan")}), "must be a number of degrees"),
+    (dict(fixed_pose_deg={POSE_NAMES[0]: "down"}), "must be a number of degrees"),
 ])
 def test_view_target_rejects_bad_input(kwargs, message):
     args = dict(name="front", mask=np.ones((4, 4), bool), camera=front_camera(),
