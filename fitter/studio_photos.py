@@ -9,16 +9,27 @@ scaled to ``body_px`` pixels tall. The side photo shows the body's left side (fa
 image's left, as a camera at the person's left sees it) without the arms: the model's
 four pose angles cannot hang the arms down against the body, so this scene stands for a
 side photo whose arms hide within the torso's profile.
+
+Two cameras: the paper's orthographic projection (:func:`photo`, :func:`write_subject`):
+the body is scaled to ``body_px`` pixels tall; or a pinhole camera with a given K at a
+given distance and height, its axis horizontal (:func:`pinhole_photo`,
+:func:`write_pinhole_subject`, which also writes the camera as camera.json).
 """
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import cv2
 import numpy as np
 
+from bodyfit.calib.camera import Camera, camera_fields
+
 from bodyfit.fitter.body_model import PART_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import Measurer
-from bodyfit.fitter.render import render_parts
+from bodyfit.fitter.pinhole_canvas import Placement
+from bodyfit.fitter.render import render_parts, render_pinhole
 
 BACKDROP_BGR = (170, 185, 200)
 SIDE_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
@@ -41,7 +52,29 @@ def photo(vertices, model, view: str, parts, body_px: int = 700,
     return canvas
 
 
-__all__ = ["photo", "write_subject"]
+def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
+                  size_px: tuple[int, int], distance_m: float,
+                  camera_height_m: float) -> np.ndarray:
+    """(H, W, 3) uint8 BGR photo of posed ``vertices`` (V, 3) metres through a pinhole.
+
+    Args:
+        view: "front" or "side", the kernels' view rotations (camera axis horizontal).
+        intrinsics: (3, 3) K, pixels; size_px: (width, height).
+        distance_m: from the camera to the body's vertical axis (model origin).
+        camera_height_m: the camera above the floor (the body's lowest vertex).
+    """
+    keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in parts])
+    floor = float(vertices[:, 2].min())
+    rotation, translation = Placement(distance_m, camera_height_m, 0.0, -floor).extrinsics(view)
+    image = render_pinhole(vertices, model.faces[keep], model.face_parts[keep], intrinsics,
+                           rotation, translation, size_px)
+    canvas = np.full_like(image, BACKDROP_BGR)
+    body = image.min(axis=2) < 250
+    canvas[body] = image[body]
+    return canvas
+
+
+__all__ = ["photo", "pinhole_photo", "write_subject", "write_pinhole_subject"]
 
 
 def write_subject(folder, model, betas, pose_deg) -> dict[str, float]:
@@ -51,4 +84,22 @@ def write_subject(folder, model, betas, pose_deg) -> dict[str, float]:
     posed = forward(model, betas, pose_deg)[0]
     cv2.imwrite(str(folder / "front.png"), photo(posed, model, "front", PART_NAMES))
     cv2.imwrite(str(folder / "side.png"), photo(posed, model, "side", SIDE_PARTS))
+    return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])
+
+
+def write_pinhole_subject(folder, model, betas, pose_deg, intrinsics: np.ndarray,
+                          size_px: tuple[int, int], distance_m: float,
+                          camera_height_m: float) -> dict[str, float]:
+    """Write front.png, side.png (:func:`pinhole_photo`, both views from the same distance
+    and height) and camera.json (``intrinsics``, no distortion) into ``folder``; return the
+    true measurements (key -> mm) of the rest body."""
+    folder = Path(folder)
+    betas, pose_deg = np.atleast_2d(betas), np.atleast_2d(pose_deg)
+    posed = forward(model, betas, pose_deg)[0].astype(np.float64)
+    for view, parts in (("front", PART_NAMES), ("side", SIDE_PARTS)):
+        cv2.imwrite(str(folder / f"{view}.png"),
+                    pinhole_photo(posed, model, view, parts, intrinsics, size_px, distance_m,
+                                  camera_height_m))
+    camera = Camera(tuple(size_px), np.asarray(intrinsics, float), np.zeros(5))
+    (folder / "camera.json").write_text(json.dumps(camera_fields(camera), indent=2))
     return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])
