@@ -19,6 +19,7 @@ from bodyfit import kernels
 from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import CanvasSettings, model_extent, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
+from bodyfit.fitter.pinhole_canvas import pinhole_view
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
 
 __all__ = ["FitSettings", "Fit", "fit_person"]
@@ -36,12 +37,15 @@ class FitSettings:
         canvas: canvas geometry.
         cost: the kernels' weights and matching (the paper's Table 2 by default).
         device: where the kernels run, "cpu" or "cuda:0".
+        projection: "orthographic" (the paper's, each view scaled from the stature) or
+            "pinhole" (the photos' camera, :mod:`bodyfit.fitter.pinhole_canvas`).
     """
 
     search: SearchSettings = SearchSettings()
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = kernels.CostSettings()
     device: str = "cpu"
+    projection: str = "orthographic"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -78,8 +82,18 @@ def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult) -> dict
     return dict(zip(MEASUREMENTS, spread.tolist()))
 
 
+def _view(name, mask, intrinsics, stature_m, extent, mean_body, settings) -> kernels.ViewTarget:
+    """One view's target with ``settings.projection`` (``intrinsics``: (3, 3) K for pinhole)."""
+    if settings.projection == "pinhole":
+        return pinhole_view(name, mask, intrinsics, stature_m, extent, mean_body,
+                            settings.canvas, settings.device)
+    return orthographic_view(name, mask, stature_m, extent, mean_body, settings.canvas,
+                             settings.device)
+
+
 def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
-               settings: FitSettings = FitSettings(), progress: bool | None = None) -> Fit:
+               settings: FitSettings = FitSettings(), progress: bool | None = None,
+               intrinsics: dict[str, np.ndarray] | None = None) -> Fit:
     """Fit the body model to a person's front and side silhouettes.
 
     Args:
@@ -88,7 +102,14 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
         stature_m: the person's stature, metres (scales each view, Section 3.3).
         settings: search, canvas, cost, device.
         progress: show the search's progress bar (None: when stderr is a terminal).
+        intrinsics: {"front": K, "side": K}, (3, 3) pixels, of the upright photos the masks
+            are of; needed by the pinhole projection
+            (:func:`bodyfit.fitter.person.view_intrinsics`).
     """
+    if settings.projection not in ("orthographic", "pinhole"):
+        raise ValueError(f"projection must be orthographic or pinhole, got {settings.projection!r}")
+    if settings.projection == "pinhole" and intrinsics is None:
+        raise ValueError("the pinhole projection needs the photos' intrinsics")
     s = settings.search
     s.validate(model.num_components)
     settings.canvas.validate()
@@ -96,8 +117,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     extent = model_extent(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
                           settings.canvas.beta_limit)
     mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
-    views = {name: orthographic_view(name, masks[name], stature_m, extent, mean_body,
-                                     settings.canvas, settings.device)
+    views = {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m, extent,
+                         mean_body, settings)
              for name in ("front", "side")}
     arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)

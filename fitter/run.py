@@ -25,7 +25,7 @@ from bodyfit.fitter.body_model import POSE_NAMES, BodyModel
 from bodyfit.fitter.fit import Fit, FitSettings, fit_person
 from bodyfit.fitter.mesh_io import write_mesh
 from bodyfit.fitter.outputs import staged_directory, write_fitted_measurements, write_json
-from bodyfit.fitter.person import PersonInputs, person_masks
+from bodyfit.fitter.person import PersonInputs, person_masks, view_intrinsics
 from bodyfit.fitter.plots import line_chart
 
 __all__ = ["RUN_FILES", "check_output_dir", "run_person", "run_record"]
@@ -88,7 +88,8 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
     out_dir = Path(out_dir)
     check_output_dir(out_dir, overwrite)
     masks = person_masks(inputs)
-    fit = fit_person(model, masks, inputs.height_cm / 100.0, settings, progress)
+    intrinsics = view_intrinsics(inputs, masks) if settings.projection == "pinhole" else None
+    fit = fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics)
     result = fit.search
     chart = line_chart({"best so far": result.best_costs, "generation mean": result.mean_costs},
                        f"search: {settings.search.optimizer}, {result.evaluations} candidates",
