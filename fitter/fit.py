@@ -82,11 +82,12 @@ def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult) -> dict
     return dict(zip(MEASUREMENTS, spread.tolist()))
 
 
-def _view(name, mask, intrinsics, stature_m, extent, mean_body, settings) -> kernels.ViewTarget:
+def _view(name, mask, intrinsics, stature_m, extent, mean_body, model,
+          settings) -> kernels.ViewTarget:
     """One view's target with ``settings.projection`` (``intrinsics``: (3, 3) K for pinhole)."""
     if settings.projection == "pinhole":
         return pinhole_view(name, mask, intrinsics, stature_m, extent, mean_body,
-                            settings.canvas, settings.device)
+                            model.vertex_parts, settings.canvas, settings.device)
     return orthographic_view(name, mask, stature_m, extent, mean_body, settings.canvas,
                              settings.device)
 
@@ -118,7 +119,7 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                           settings.canvas.beta_limit)
     mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
     views = {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m, extent,
-                         mean_body, settings)
+                         mean_body, model, settings)
              for name in ("front", "side")}
     arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)

@@ -42,6 +42,7 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.calib.errors import UserError
+from bodyfit.fitter.body_model import PART_NAMES
 from bodyfit.fitter.canvas import VIEW_PARTS, CanvasSettings
 from bodyfit.kernels.view_camera import paper_rotation
 
@@ -145,8 +146,9 @@ def solve_placement(name: str, mask: np.ndarray, intrinsics: np.ndarray,
         name: ``"front"`` or ``"side"``.
         mask: (H, W) bool silhouette of the undistorted upright photo.
         intrinsics: (3, 3) K of that photo, pixels.
-        body: (V, 3) metres, model frame: a body of the person's stature (the mean body
-            scaled to it), standing on the floor at its lowest vertex.
+        body: (V, 3) metres, model frame: the parts the view shows of a body of the
+            person's stature (the mean body scaled to it), standing on the floor at its
+            lowest vertex.
     """
     k = np.asarray(intrinsics, float)
     r = view_rotation(name)
@@ -195,7 +197,7 @@ def _crop(mask: np.ndarray, low: np.ndarray, high: np.ndarray,
 
 
 def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m: float,
-                 extent: np.ndarray, mean_body: np.ndarray,
+                 extent: np.ndarray, mean_body: np.ndarray, vertex_parts: np.ndarray,
                  settings: CanvasSettings = CanvasSettings(),
                  device: str = "cpu") -> kernels.ViewTarget:
     """One view of the person on a canvas with a pinhole camera placed from the stature.
@@ -208,6 +210,8 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
         stature_m: the person's stature, metres.
         extent: (M, 3) float32 metres, from :func:`bodyfit.fitter.canvas.model_extent`.
         mean_body: (V, 3) float32 metres, the mean body in its default pose.
+        vertex_parts: (V,) int, each vertex's index in ``PART_NAMES``: the placement is
+            solved with the parts the view shows (no arms in the side view).
         settings: canvas geometry.
         device: where the kernels run.
 
@@ -216,7 +220,8 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
     """
     k = np.asarray(intrinsics, float)
     body = mean_body.astype(np.float64) * (stature_m / np.ptp(mean_body[:, 2]))
-    placement = solve_placement(name, mask, k, body)
+    shown = np.isin(vertex_parts, [PART_NAMES.index(p) for p in VIEW_PARTS[name]])
+    placement = solve_placement(name, mask, k, body[shown])
     r, t = placement.extrinsics(name)
     rows, cols = np.nonzero(mask)
     scale = settings.body_height_px / (rows.max() - rows.min() + 1)

@@ -14,7 +14,8 @@ import numpy as np
 
 from bodyfit.fitter.body_model import PART_NAMES
 
-__all__ = ["PART_COLOURS_BGR", "render_parts", "render_pinhole", "parts_legend", "labelled_grid"]
+__all__ = ["PART_COLOURS_BGR", "render_parts", "render_pinhole", "pinhole_pixels",
+           "coverage_mask", "parts_legend", "labelled_grid"]
 
 #: One BGR colour per part, ``PART_NAMES`` order.
 PART_COLOURS_BGR = np.array([
@@ -74,13 +75,35 @@ def render_pinhole(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarr
     Returns:
         (height, width, 3) uint8 BGR image on white; every vertex must be in front of the camera.
     """
+    px, depth = pinhole_pixels(vertices, intrinsics, rotation, translation_m)
+    image = np.full((size_px[1], size_px[0], 3), 255, np.uint8)
+    return _paint(image, px, -depth, vertices, faces, face_parts,
+                  -np.asarray(rotation, float)[2])
+
+
+def pinhole_pixels(vertices: np.ndarray, intrinsics: np.ndarray, rotation: np.ndarray,
+                   translation_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(V, 2) pixels and (V,) depths, metres, of ``vertices`` (V, 3) through a pinhole
+    (arguments as :func:`render_pinhole`); ValueError if a vertex is not in front of it."""
     cam = vertices @ np.asarray(rotation, float).T + np.asarray(translation_m, float)
     if not np.all(cam[:, 2] > 0):
-        raise ValueError("render_pinhole() needs every vertex in front of the camera")
-    px = (cam / cam[:, 2:]) @ np.asarray(intrinsics, float).T
-    image = np.full((size_px[1], size_px[0], 3), 255, np.uint8)
-    return _paint(image, px[:, :2], -cam[:, 2], vertices, faces, face_parts,
-                  -np.asarray(rotation, float)[2])
+        raise ValueError("a pinhole rendering needs every vertex in front of the camera")
+    return (cam[:, :2] / cam[:, 2:]) @ np.asarray(intrinsics, float)[:2, :2].T \
+        + np.asarray(intrinsics, float)[:2, 2], cam[:, 2]
+
+
+def coverage_mask(px: np.ndarray, faces: np.ndarray, size_px: tuple[int, int],
+                  supersample: int = 4) -> np.ndarray:
+    """(H, W) bool: the pixels that triangles ``px[faces]`` ((V, 2) pixels) cover by more
+    than half, filled at ``supersample`` times the resolution and area-averaged (OpenCV's
+    polygon fill takes every pixel it touches: 1 px too wide at 1x, 1/supersample px here)."""
+    width, height = size_px
+    fine = np.zeros((height * supersample, width * supersample), np.uint8)
+    corners = (px[faces] + 0.5) * supersample - 0.5  # pixel centres at the finer grid's
+    polygons = np.round(corners * (1 << _SUBPIXEL_BITS)).astype(np.int32)
+    for polygon in polygons:  # one call per triangle: several polygons fill even-odd
+        cv2.fillConvexPoly(fine, polygon, 1, lineType=cv2.LINE_8, shift=_SUBPIXEL_BITS)
+    return cv2.resize(fine.astype(np.float32), (width, height), interpolation=cv2.INTER_AREA) > 0.5
 
 
 def _paint(image, px, toward_depth, vertices, faces, face_parts, toward) -> np.ndarray:

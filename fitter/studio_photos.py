@@ -29,7 +29,7 @@ from bodyfit.calib.camera import Camera, camera_fields
 from bodyfit.fitter.body_model import PART_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.pinhole_canvas import Placement
-from bodyfit.fitter.render import render_parts, render_pinhole
+from bodyfit.fitter.render import coverage_mask, pinhole_pixels, render_parts, render_pinhole
 
 BACKDROP_BGR = (170, 185, 200)
 SIDE_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
@@ -62,14 +62,18 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
         intrinsics: (3, 3) K, pixels; size_px: (width, height).
         distance_m: from the camera to the body's vertical axis (model origin).
         camera_height_m: the camera above the floor (the body's lowest vertex).
+
+    The person's pixels are those the body covers by more than half (sub-pixel outline).
     """
     keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in parts])
     floor = float(vertices[:, 2].min())
     rotation, translation = Placement(distance_m, camera_height_m, 0.0, -floor).extrinsics(view)
-    image = render_pinhole(vertices, model.faces[keep], model.face_parts[keep], intrinsics,
-                           rotation, translation, size_px)
+    faces = model.faces[keep]
+    image = render_pinhole(vertices, faces, model.face_parts[keep], intrinsics, rotation,
+                           translation, size_px)
+    body = coverage_mask(pinhole_pixels(vertices, intrinsics, rotation, translation)[0], faces,
+                         size_px)
     canvas = np.full_like(image, BACKDROP_BGR)
-    body = image.min(axis=2) < 250
     canvas[body] = image[body]
     return canvas
 
