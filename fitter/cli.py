@@ -17,6 +17,9 @@ from bodyfit.calib.errors import UserError
 
 __all__ = ["main"]
 
+#: The projection without --camera (docs/fitter.md, Cameras: chosen by the benchmark).
+NO_CAMERA_PROJECTION = "orthographic"
+
 logger = logging.getLogger("bodyfit")
 
 
@@ -56,8 +59,9 @@ def _build_parser() -> argparse.ArgumentParser:
         "run", help="fit the body model to a person's front and side photos: mesh (m), "
                     "16 measurements (mm), convergence plot, run record",
         description="Fit bodyfit's body model to a front photo (A-pose) and a side photo "
-                    "(arms hanging down) on a plain backdrop. Cameras: the paper's "
-                    "orthographic projection, each view scaled from the stature.")
+                    "(arms hanging down) on a plain backdrop. Cameras: with --camera, "
+                    "the calibrated pinhole camera, the person's distance solved from the "
+                    "stature; without, see --projection (docs/fitter.md, Cameras).")
     run.add_argument("--config", type=Path, metavar="run.json",
                      help="repeat a previous run: its inputs and settings from its run.json "
                           "(the options given here override them)")
@@ -70,7 +74,13 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("-o", "--output", type=Path, metavar="OUT",
                      help="output folder (created; must be empty unless --overwrite)")
     run.add_argument("--camera", metavar="camera.json",
-                     help="undistort the photos with this calibration (calib capture)")
+                     help="the calibrated camera (calib capture): the photos are undistorted "
+                          "and fitted through it")
+    run.add_argument("--projection", choices=("orthographic", "pinhole"),
+                     help="pinhole: the camera of --camera, or without it a typical phone "
+                          "camera (70 degrees across the long side); "
+                          "orthographic: the paper's, each view scaled from the stature "
+                          f"(default: pinhole with --camera, else {NO_CAMERA_PROJECTION})")
     run.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
                      "(white person on black, of the undistorted upright photo)")
     run.add_argument("--mask-side", metavar="PNG", help="your own side silhouette")
@@ -215,7 +225,10 @@ def _run_settings(args):
             cost = settings_from_record(record, cost)
     settings = dataclasses.replace(settings, search=search, cost=cost,
                                    device=given.get("device", settings.device),
-                                   side_arms=given.get("side_arms", settings.side_arms))
+                                   side_arms=given.get("side_arms", settings.side_arms),
+                                   projection=given.get("projection") or (
+                                       settings.projection if args.config else "pinhole"
+                                       if inputs.camera else NO_CAMERA_PROJECTION))
     return inputs, settings, output
 
 

@@ -19,6 +19,7 @@ from bodyfit import kernels
 from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import CanvasSettings, model_extent, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
+from bodyfit.fitter.pinhole_canvas import pinhole_view
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, stature_scale
@@ -41,6 +42,8 @@ class FitSettings:
         side_arms: how the side view treats the person's arms, one of
             ``bodyfit.fitter.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
             arms hanging down; "hidden": without arms).
+        projection: "orthographic" (the paper's, each view scaled from the stature) or
+            "pinhole" (the photos' camera, :mod:`bodyfit.fitter.pinhole_canvas`).
     """
 
     search: SearchSettings = SearchSettings()
@@ -48,6 +51,7 @@ class FitSettings:
     cost: kernels.CostSettings = kernels.CostSettings()
     device: str = "cpu"
     side_arms: str = "down"
+    projection: str = "orthographic"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -89,8 +93,21 @@ def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult,
     return dict(zip(MEASUREMENTS, spread.tolist()))
 
 
+def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
+          view_options: dict) -> kernels.ViewTarget:
+    """One view's target with ``settings.projection`` (``intrinsics``: (3, 3) K for pinhole;
+    ``view_options``: the side view's arms, :func:`~bodyfit.fitter.side_arms.side_view_options`)."""
+    if settings.projection == "pinhole":
+        return pinhole_view(name, mask, intrinsics, stature_m, extent, mean_body,
+                            model.vertex_parts, settings.canvas, settings.device,
+                            **view_options)
+    return orthographic_view(name, mask, stature_m, extent, mean_body, settings.canvas,
+                             settings.device, **view_options)
+
+
 def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
-               settings: FitSettings = FitSettings(), progress: bool | None = None) -> Fit:
+               settings: FitSettings = FitSettings(), progress: bool | None = None,
+               intrinsics: dict[str, np.ndarray] | None = None) -> Fit:
     """Fit the body model to a person's front and side silhouettes.
 
     Args:
@@ -99,7 +116,14 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
         stature_m: the person's stature, metres (scales each view, Section 3.3).
         settings: search, canvas, cost, device.
         progress: show the search's progress bar (None: when stderr is a terminal).
+        intrinsics: {"front": K, "side": K}, (3, 3) pixels, of the upright photos the masks
+            are of; needed by the pinhole projection
+            (:func:`bodyfit.fitter.person.view_intrinsics`).
     """
+    if settings.projection not in ("orthographic", "pinhole"):
+        raise ValueError(f"projection must be orthographic or pinhole, got {settings.projection!r}")
+    if settings.projection == "pinhole" and intrinsics is None:
+        raise ValueError("the pinhole projection needs the photos' intrinsics")
     s = settings.search
     s.validate(model.num_components)
     settings.canvas.validate()
@@ -110,8 +134,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     # arms turned down in the frontal plane keep their side-view width and stay above
     # the feet, so the extent of the search's pose range covers them
     options = {"front": {}, "side": side_view_options(model, settings.side_arms)}
-    views = {name: orthographic_view(name, masks[name], stature_m, extent, mean_body,
-                                     settings.canvas, settings.device, **options[name])
+    views = {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m, extent,
+                         mean_body, model, settings, options[name])
              for name in ("front", "side")}
     arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)

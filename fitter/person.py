@@ -15,9 +15,11 @@ import numpy as np
 
 from bodyfit.calib.camera import load_camera
 from bodyfit.calib.errors import UserError
+from bodyfit.calib.images import read_photo
 from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
+from bodyfit.fitter.pinhole_canvas import phone_intrinsics, upright_intrinsics
 
-__all__ = ["PersonInputs", "STATURE_RANGE_CM", "person_masks"]
+__all__ = ["PersonInputs", "STATURE_RANGE_CM", "person_masks", "view_intrinsics"]
 
 #: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
 #: most likely given in other units).
@@ -91,3 +93,28 @@ def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
         raise UserError(f"the side silhouette is wider than the front one ({aspect['side']:.2f} "
                         f"vs {aspect['front']:.2f} of the height): are --front and --side swapped?")
     return masks
+
+
+def view_intrinsics(inputs: PersonInputs, masks: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """{"front": K, "side": K}: (3, 3) pixels, the camera matrix of each upright photo.
+
+    camera.json's K turned as the photo's EXIF orientation turns it upright; without
+    camera.json, a typical phone's (:func:`bodyfit.fitter.pinhole_canvas.phone_intrinsics`).
+
+    Raises:
+        UserError: a mirrored photo, or a mask of another size than the upright photo.
+    """
+    if inputs.camera is None:
+        return {view: phone_intrinsics(mask.shape) for view, mask in masks.items()}
+    camera = load_camera(inputs.camera)
+    found = {}
+    for view, mask in masks.items():
+        orientation = read_photo(getattr(inputs, view)).orientation
+        k = upright_intrinsics(camera.K, camera.image_size_px, orientation)
+        width, height = camera.image_size_px
+        size = (height, width) if orientation in (1, 3) else (width, height)
+        if mask.shape != size:
+            raise UserError(f"the {view} silhouette is {mask.shape[1]}x{mask.shape[0]} pixels but "
+                            f"the upright photo of the camera is {size[1]}x{size[0]}")
+        found[view] = k
+    return found

@@ -1,7 +1,8 @@
 """Pictures of bodies coloured by part (for people to look at, not for fitting).
 
 A painter's-algorithm rendering with OpenCV polygon fill: triangles sorted far to near,
-each filled with its part's colour shaded by how squarely it faces the viewer. Front
+each filled with its part's colour shaded by how squarely it faces the viewer; scaled
+orthographic (:func:`render_parts`) or through a pinhole camera (:func:`render_pinhole`). Front
 view looks at the body from -y (the body's left appears on the image's right); side view
 looks from the body's left (+x), the body facing the image's right.
 """
@@ -13,7 +14,8 @@ import numpy as np
 
 from bodyfit.fitter.body_model import PART_NAMES
 
-__all__ = ["PART_COLOURS_BGR", "render_parts", "parts_legend", "labelled_grid"]
+__all__ = ["PART_COLOURS_BGR", "render_parts", "render_pinhole", "pinhole_pixels",
+           "coverage_mask", "parts_legend", "labelled_grid"]
 
 #: One BGR colour per part, ``PART_NAMES`` order.
 PART_COLOURS_BGR = np.array([
@@ -54,13 +56,66 @@ def render_parts(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray
     px = np.stack([(u - u.min()) * scale + margin_px, (z.max() - z) * scale + margin_px], 1)
     width = int(np.ceil(px[:, 0].max())) + margin_px
     image = np.full((height_px, width, 3), 255, np.uint8)
+    return _paint(image, px, depth, vertices, faces, face_parts, toward)
+
+
+def render_pinhole(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray,
+                   intrinsics: np.ndarray, rotation: np.ndarray, translation_m: np.ndarray,
+                   size_px: tuple[int, int]) -> np.ndarray:
+    """Render a body through a pinhole camera (no lens distortion), painter's algorithm.
+
+    Args:
+        vertices: (V, 3) float, metres, model frame.
+        faces: (F, 3) int triangles.
+        face_parts: (F,) int part label of each face.
+        intrinsics: (3, 3) K, pixels; rotation (3, 3) and translation_m (3,): model frame ->
+            camera frame (x right, y down, z forward), as :mod:`bodyfit.kernels.view_camera`.
+        size_px: (width, height) of the image.
+
+    Returns:
+        (height, width, 3) uint8 BGR image on white; every vertex must be in front of the camera.
+    """
+    px, depth = pinhole_pixels(vertices, intrinsics, rotation, translation_m)
+    image = np.full((size_px[1], size_px[0], 3), 255, np.uint8)
+    return _paint(image, px, -depth, vertices, faces, face_parts,
+                  -np.asarray(rotation, float)[2])
+
+
+def pinhole_pixels(vertices: np.ndarray, intrinsics: np.ndarray, rotation: np.ndarray,
+                   translation_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(V, 2) pixels and (V,) depths, metres, of ``vertices`` (V, 3) through a pinhole
+    (arguments as :func:`render_pinhole`); ValueError if a vertex is not in front of it."""
+    cam = vertices @ np.asarray(rotation, float).T + np.asarray(translation_m, float)
+    if not np.all(cam[:, 2] > 0):
+        raise ValueError("a pinhole rendering needs every vertex in front of the camera")
+    return (cam[:, :2] / cam[:, 2:]) @ np.asarray(intrinsics, float)[:2, :2].T \
+        + np.asarray(intrinsics, float)[:2, 2], cam[:, 2]
+
+
+def coverage_mask(px: np.ndarray, faces: np.ndarray, size_px: tuple[int, int],
+                  supersample: int = 4) -> np.ndarray:
+    """(H, W) bool: the pixels that triangles ``px[faces]`` ((V, 2) pixels) cover by more
+    than half, filled at ``supersample`` times the resolution and area-averaged (OpenCV's
+    polygon fill takes every pixel it touches: 1 px too wide at 1x, 1/supersample px here)."""
+    width, height = size_px
+    fine = np.zeros((height * supersample, width * supersample), np.uint8)
+    corners = (px[faces] + 0.5) * supersample - 0.5  # pixel centres at the finer grid's
+    polygons = np.round(corners * (1 << _SUBPIXEL_BITS)).astype(np.int32)
+    for polygon in polygons:  # one call per triangle: several polygons fill even-odd
+        cv2.fillConvexPoly(fine, polygon, 1, lineType=cv2.LINE_8, shift=_SUBPIXEL_BITS)
+    return cv2.resize(fine.astype(np.float32), (width, height), interpolation=cv2.INTER_AREA) > 0.5
+
+
+def _paint(image, px, toward_depth, vertices, faces, face_parts, toward) -> np.ndarray:
+    """Fill each triangle of ``px`` ((V, 2) pixels) far to near (small ``toward_depth``
+    first), shaded by how squarely it faces ``toward`` (unit vector to the viewer)."""
     tri = vertices[faces]
     normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normals /= np.linalg.norm(normals, axis=1, keepdims=True) + 1e-12
     shade = 0.35 + 0.65 * np.abs(normals @ toward)
     colours = PART_COLOURS_BGR[face_parts] * shade[:, None]
     polygons = np.round(px[faces] * (1 << _SUBPIXEL_BITS)).astype(np.int32)
-    for f in np.argsort(depth[faces].mean(axis=1)):  # far (small "toward") to near
+    for f in np.argsort(toward_depth[faces].mean(axis=1)):  # far (small "toward") to near
         cv2.fillPoly(image, [polygons[f]], colours[f].tolist(), lineType=cv2.LINE_AA,
                      shift=_SUBPIXEL_BITS)
     return image

@@ -32,7 +32,7 @@ from bodyfit.fitter.mesh_io import write_mesh
 from bodyfit.fitter.outputs import (staged_directory, write_fitted_measurements, write_json,
                                     write_text)
 from bodyfit.fitter.overlays import fitted_outline_image, match_contours, overlay_image
-from bodyfit.fitter.person import PersonInputs, person_masks
+from bodyfit.fitter.person import PersonInputs, person_masks, view_intrinsics
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.report import report_html
 from bodyfit.fitter.weights import weights_record
@@ -102,7 +102,8 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
     out_dir = Path(out_dir)
     check_output_dir(out_dir, overwrite)
     masks = person_masks(inputs)
-    fit = fit_person(model, masks, inputs.height_cm / 100.0, settings, progress)
+    intrinsics = view_intrinsics(inputs, masks) if settings.projection == "pinhole" else None
+    fit = fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics)
     result = fit.search
     chart = line_chart({"best so far": result.best_costs, "generation mean": result.mean_costs},
                        f"search: {settings.search.optimizer}, {result.evaluations} candidates",

@@ -15,16 +15,27 @@ at the person's left sees it), with ``side_arms``:
   in front of and beside the torso's profile;
 - ``"hidden"``: the body in the front photo's pose without arm, elbow and hand: a side
   photo whose arms hide within the torso's profile.
+
+Two cameras: the paper's orthographic projection (:func:`photo`, :func:`write_subject`):
+the body is scaled to ``body_px`` pixels tall; or a pinhole camera with a given K at a
+given distance and height, its axis horizontal (:func:`pinhole_photo`,
+:func:`write_pinhole_subject`, which also writes the camera as camera.json).
 """
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import cv2
 import numpy as np
 
+from bodyfit.calib.camera import Camera, camera_fields
+
 from bodyfit.fitter.body_model import PART_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import Measurer
-from bodyfit.fitter.render import render_parts
+from bodyfit.fitter.pinhole_canvas import Placement
+from bodyfit.fitter.render import coverage_mask, pinhole_pixels, render_parts, render_pinhole
 from bodyfit.fitter.side_arms import side_photo_pose
 
 BACKDROP_BGR = (170, 185, 200)
@@ -48,7 +59,33 @@ def photo(vertices, model, view: str, parts, body_px: int = 700,
     return canvas
 
 
-__all__ = ["SIDE_ARMS", "photo", "write_subject"]
+def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
+                  size_px: tuple[int, int], distance_m: float,
+                  camera_height_m: float) -> np.ndarray:
+    """(H, W, 3) uint8 BGR photo of posed ``vertices`` (V, 3) metres through a pinhole.
+
+    Args:
+        view: "front" or "side", the kernels' view rotations (camera axis horizontal).
+        intrinsics: (3, 3) K, pixels; size_px: (width, height).
+        distance_m: from the camera to the body's vertical axis (model origin).
+        camera_height_m: the camera above the floor (the body's lowest vertex).
+
+    The person's pixels are those the body covers by more than half (sub-pixel outline).
+    """
+    keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in parts])
+    floor = float(vertices[:, 2].min())
+    rotation, translation = Placement(distance_m, camera_height_m, 0.0, -floor).extrinsics(view)
+    faces = model.faces[keep]
+    image = render_pinhole(vertices, faces, model.face_parts[keep], intrinsics, rotation,
+                           translation, size_px)
+    body = coverage_mask(pinhole_pixels(vertices, intrinsics, rotation, translation)[0], faces,
+                         size_px)
+    canvas = np.full_like(image, BACKDROP_BGR)
+    canvas[body] = image[body]
+    return canvas
+
+
+__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "write_subject", "write_pinhole_subject"]
 
 
 SIDE_ARMS = ("down", "hidden")
@@ -64,15 +101,39 @@ def write_subject(folder, model, betas, pose_deg, side_arms: str = "down") -> di
         pose_deg: (4,) front photo's abduction angles, degrees, ``POSE_NAMES`` order.
         side_arms: ``"down"`` or ``"hidden"`` (module docstring).
     """
-    if side_arms not in SIDE_ARMS:
-        raise ValueError(f"side_arms must be one of {SIDE_ARMS}, got {side_arms!r}")
     betas, pose_deg = np.atleast_2d(betas), np.atleast_2d(pose_deg)
+    side, parts = _side_body(model, betas, pose_deg, side_arms)
     posed = forward(model, betas, pose_deg)[0]
     cv2.imwrite(str(folder / "front.png"), photo(posed, model, "front", PART_NAMES))
+    cv2.imwrite(str(folder / "side.png"), photo(side, model, "side", parts))
+    return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])
+
+
+def _side_body(model, betas: np.ndarray, pose_deg: np.ndarray, side_arms: str):
+    """(posed vertices (V, 3), parts shown) of the side photo (``side_arms``, module
+    docstring); betas (1, K), pose_deg (1, 4) of the front photo."""
+    if side_arms not in SIDE_ARMS:  # checked before any work
+        raise ValueError(f"side_arms must be one of {SIDE_ARMS}, got {side_arms!r}")
     if side_arms == "down":
         side_pose = side_photo_pose(model, betas[0], pose_deg[0])[None]
-        side = photo(forward(model, betas, side_pose)[0], model, "side", PART_NAMES)
-    else:
-        side = photo(posed, model, "side", SIDE_PARTS)
-    cv2.imwrite(str(folder / "side.png"), side)
+        return forward(model, betas, side_pose)[0], PART_NAMES
+    return forward(model, betas, pose_deg)[0], SIDE_PARTS
+
+
+def write_pinhole_subject(folder, model, betas, pose_deg, intrinsics: np.ndarray,
+                          size_px: tuple[int, int], distance_m: float,
+                          camera_height_m: float, side_arms: str = "down") -> dict[str, float]:
+    """Write front.png, side.png (:func:`pinhole_photo`, both views from the same distance
+    and height; the side photo's arms as ``side_arms``) and camera.json (``intrinsics``, no
+    distortion) into ``folder``; return the true measurements (key -> mm) of the rest body."""
+    folder = Path(folder)
+    betas, pose_deg = np.atleast_2d(betas), np.atleast_2d(pose_deg)
+    views = {"front": (forward(model, betas, pose_deg)[0], PART_NAMES),
+             "side": _side_body(model, betas, pose_deg, side_arms)}
+    for view, (posed, parts) in views.items():
+        cv2.imwrite(str(folder / f"{view}.png"),
+                    pinhole_photo(posed.astype(np.float64), model, view, parts, intrinsics,
+                                  size_px, distance_m, camera_height_m))
+    camera = Camera(tuple(size_px), np.asarray(intrinsics, float), np.zeros(5))
+    (folder / "camera.json").write_text(json.dumps(camera_fields(camera), indent=2))
     return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])

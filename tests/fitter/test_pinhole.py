@@ -1,0 +1,140 @@
+"""Pinhole views (fitter/pinhole_canvas.py): K of upright photos, the placement solved from
+the stature, the canvas crop, and `fitter run --camera` end to end."""
+
+import json
+
+import cv2
+import numpy as np
+import pytest
+
+from bodyfit.calib.errors import UserError
+from bodyfit.calib.images import to_upright
+from bodyfit.fitter.body_model import PART_NAMES, forward
+from bodyfit.fitter.canvas import VIEW_PARTS, model_extent
+from bodyfit.fitter.cli import main
+from bodyfit.fitter.pinhole_canvas import (Placement, phone_intrinsics, pinhole_view,
+                                           solve_placement, upright_intrinsics)
+from bodyfit.fitter.run import RUN_FILES
+from bodyfit.fitter.studio_photos import BACKDROP_BGR, pinhole_photo, write_pinhole_subject
+from bodyfit.kernels.view_camera import camera_matrices
+
+SIZE_PX = (750, 1000)
+#: a camera unlike the phone assumption: fx != fy, principal point off the centre
+K_TRUE = np.array([[820.0, 0.0, 381.0], [0.0, 812.0, 488.0], [0.0, 0.0, 1.0]])
+SUBJECT_BETAS = np.array([1.2, 0.7, -0.8, 0.4, 0.5] + [0.0] * 15)
+SUBJECT_POSE = np.array([5.0, 5.0, 3.0, 3.0])
+
+
+def person_mask(image):
+    return np.any(image != np.array(BACKDROP_BGR, np.uint8), axis=2)
+
+
+def project(k, r, t, points):
+    cam = points @ r.T + t
+    return (cam[:, :2] / cam[:, 2:]) @ k[:2, :2].T + k[:2, 2]
+
+
+@pytest.fixture(scope="module")
+def mean_body(body_model):
+    return forward(body_model, np.zeros((1, 20)), np.zeros((1, 4)))[0]
+
+
+@pytest.mark.parametrize("orientation", [1, 3, 6, 8])
+def test_upright_intrinsics_follow_the_exif_turn(orientation):
+    width, height = 64, 48
+    k = np.array([[70.0, 0.0, 30.0], [0.0, 55.0, 21.0], [0.0, 0.0, 1.0]])
+    pixels = np.array([[5, 7], [60, 40], [30, 21], [12, 44]])
+    rays, upright_rays = [], []
+    k_up = upright_intrinsics(k, (width, height), orientation)
+    for u, v in pixels:
+        image = np.zeros((height, width), np.uint8)
+        image[v, u] = 1
+        row, col = np.argwhere(to_upright(image, orientation))[0]
+        rays.append(np.linalg.solve(k, [u, v, 1.0]))
+        upright_rays.append(np.linalg.solve(k_up, [col, row, 1.0]))
+    rays, upright_rays = np.array(rays), np.array(upright_rays)
+    # a turn about the optical axis keeps every ray's depth and the angles between rays
+    np.testing.assert_allclose(upright_rays @ upright_rays.T, rays @ rays.T, rtol=1e-9)
+    np.testing.assert_allclose(upright_rays[:, 2], 1.0)
+
+
+@pytest.mark.parametrize("orientation", [2, 4, 5, 7])
+def test_mirrored_photos_are_refused(orientation):
+    with pytest.raises(UserError, match="mirror"):
+        upright_intrinsics(np.eye(3), (10, 10), orientation)
+
+
+def test_phone_intrinsics_see_70_degrees_across_the_long_side():
+    k = phone_intrinsics((2000, 1500))
+    assert np.degrees(2 * np.arctan(1000 / k[0, 0])) == pytest.approx(70.0)
+    assert (k[0, 2], k[1, 2]) == (749.5, 999.5)
+
+
+def test_a_body_point_lands_where_the_photo_has_it(body_model, mean_body):
+    """The mean body photographed from 3 m: the view's camera (placement solved from the
+    stature, K cropped and scaled) projects its vertices to the photo's pixels."""
+    body = mean_body.astype(np.float64)
+    truth = Placement(3.0, 1.3, 0.0, -body[:, 2].min())
+    for view, parts in VIEW_PARTS.items():
+        mask = person_mask(pinhole_photo(body, body_model, view, parts, K_TRUE, SIZE_PX,
+                                         truth.distance_m, truth.height_m))
+        extent = model_extent(body_model, 20, [-5.0] * 4, [30.0] * 4)
+        target = pinhole_view(view, mask, K_TRUE, float(np.ptp(body[:, 2])), extent, mean_body,
+                              body_model.vertex_parts)
+        k_canvas, r, t = camera_matrices(target.camera)
+        canvas_to_photo = K_TRUE @ np.linalg.inv(k_canvas)
+        points = body[::97]
+        via_canvas = project(k_canvas, r, t, points) @ canvas_to_photo[:2, :2].T \
+            + canvas_to_photo[:2, 2]
+        expected = project(K_TRUE, *truth.extrinsics(view), points)
+        assert np.abs(via_canvas - expected).max() < 0.5, view
+        # the canvas holds the person body_height_px tall, the scale at the person's distance
+        rows = np.flatnonzero(target.boundary_distance.numpy().min(axis=1) == 0)
+        assert abs(rows[-1] - rows[0] + 1 - 400) <= 1
+        assert target.millimetres_per_pixel == pytest.approx(
+            1000 * truth.distance_m / k_canvas[1, 1], rel=0.002)
+
+
+@pytest.mark.parametrize("distance_m, height_m", [(2.6, 1.0), (3.4, 1.5)])
+def test_solved_distance_of_another_body(body_model, mean_body, tmp_path, distance_m,
+                                         height_m):
+    """A body unlike the mean one: the solved distance within 2 per cent."""
+    truth = write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, SUBJECT_POSE, K_TRUE,
+                                  SIZE_PX, distance_m, height_m)
+    body = mean_body.astype(np.float64) * (truth["O"] / 1000 / np.ptp(mean_body[:, 2]))
+    for view in ("front", "side"):
+        mask = person_mask(cv2.imread(str(tmp_path / f"{view}.png")))
+        shown = np.isin(body_model.vertex_parts, [PART_NAMES.index(p) for p in VIEW_PARTS[view]])
+        placement = solve_placement(view, mask, K_TRUE, body[shown])
+        assert placement.distance_m == pytest.approx(distance_m, rel=0.02), view
+        assert placement.height_m == pytest.approx(height_m, abs=0.05), view
+
+
+def test_run_with_camera_writes_its_outputs(body_model, tmp_path, capsys):
+    truth = write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, SUBJECT_POSE, K_TRUE,
+                                  SIZE_PX, 2.5, 1.2)
+    out = tmp_path / "out"
+    code = main(["-q", "run", "--front", str(tmp_path / "front.png"), "--side",
+                 str(tmp_path / "side.png"), "--height-cm", f"{truth['O'] / 10:.2f}",
+                 "--camera", str(tmp_path / "camera.json"), "-o", str(out),
+                 "--optimizer", "cmaes", "--population", "16", "--generations", "8"])
+    assert code == 0, capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES)
+    record = json.loads((out / "run.json").read_text())
+    assert record["settings"]["projection"] == "pinhole"
+    assert record["result"]["evaluations"] == 16 * 8
+    stature = json.loads((out / "measurements.json").read_text())["measurements"]["stature"]
+    assert abs(stature["value_mm"] - truth["O"]) < 40.0
+
+
+def test_a_camera_of_another_size_is_refused(body_model, tmp_path, capsys):
+    write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, SUBJECT_POSE, K_TRUE, SIZE_PX,
+                          3.0, 1.2)
+    camera = json.loads((tmp_path / "camera.json").read_text())
+    camera["image_size_px"] = [1000, 750]
+    (tmp_path / "camera.json").write_text(json.dumps(camera))
+    code = main(["-q", "run", "--front", str(tmp_path / "front.png"), "--side",
+                 str(tmp_path / "side.png"), "--height-cm", "175", "--camera",
+                 str(tmp_path / "camera.json"), "-o", str(tmp_path / "out")])
+    assert code == 2
+    assert "turned 90 degrees" in capsys.readouterr().err
