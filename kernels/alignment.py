@@ -9,6 +9,11 @@ transform, comes in closed form from the two silhouettes' moments (:class:`Silho
     translation: the person's centroid goes to the candidate's centroid;
     rotation:    the person's principal axis turns onto the candidate's principal axis.
 
+The vertical shift can instead match the middle of the top and bottom rows
+(``vertical_anchor="extremes"``): for candidates as tall as the person (the fitter
+conditions them on the stature) this keeps the top and bottom terms from rewarding a
+candidate for moving its mass up or down.
+
 This is exact for a silhouette that is a rotated and shifted copy of the other, costs
 one pass over per-row sums per candidate, and needs no iterations (ICP needs a
 nearest-neighbour pass per iteration). With ``align_rotation`` off only the translation is
@@ -107,8 +112,9 @@ def silhouette_moments(mask: np.ndarray) -> SilhouetteMoments:
 
 
 def rigid_transform(candidate: SilhouetteMoments, target: SilhouetteMoments,
-                    align_rotation: bool) -> np.ndarray:
-    """(3, 3) float64 homogeneous transform from person pixels to candidate pixels."""
+                    align_rotation: bool, vertical_anchor: str = "centroid") -> np.ndarray:
+    """(3, 3) float64 homogeneous transform from person pixels to candidate pixels
+    (``vertical_anchor`` as in :func:`launch_alignment`)."""
     delta = 0.0
     if align_rotation:
         d2 = candidate.orientation2 - target.orientation2
@@ -117,12 +123,16 @@ def rigid_transform(candidate: SilhouetteMoments, target: SilhouetteMoments,
     out = np.eye(3)
     out[:2, :2] = rot
     out[:2, 2] = candidate.centroid - rot @ target.centroid
+    if vertical_anchor == "extremes":
+        person_mid = np.array([target.centroid[0], (target.top[1] + target.bottom[1]) / 2])
+        moved = rot @ person_mid + out[:2, 2]
+        out[1, 2] += (candidate.top[1] + candidate.bottom[1]) / 2 - moved[1]
     return out
 
 
 @wp.kernel(enable_backward=False)
 def _align_kernel(row_moments: wp.array2d(dtype=wp.vec3d), target: WarpSilhouetteMoments,
-                  align_rotation: int, transforms: wp.array(dtype=wp.mat33),
+                  align_rotation: int, anchor_extremes: int, transforms: wp.array(dtype=wp.mat33),
                   extremes: wp.array2d(dtype=wp.vec2), areas: wp.array(dtype=wp.float32)):
     p = wp.tid()
     height = row_moments.shape[1]
@@ -168,34 +178,47 @@ def _align_kernel(row_moments: wp.array2d(dtype=wp.vec3d), target: WarpSilhouett
     c = target.centroid
     tx = wp.float32(cx) - (cs * c[0] - sn * c[1])
     ty = wp.float32(cy) - (sn * c[0] + cs * c[1])
+    if anchor_extremes != 0:
+        person_mid = 0.5 * (target.top[1] + target.bottom[1])
+        moved = sn * c[0] + cs * person_mid + ty
+        ty = ty + 0.5 * (top[1] + bottom[1]) - moved
     transforms[p] = wp.mat33(cs, -sn, tx, sn, cs, ty, 0.0, 0.0, 1.0)
 
 
 def launch_alignment(row_moments: wp.array, target: WarpSilhouetteMoments, align_rotation: bool,
-                     transforms: wp.array, extremes: wp.array, areas: wp.array) -> None:
+                     transforms: wp.array, extremes: wp.array, areas: wp.array,
+                     vertical_anchor: str = "centroid") -> None:
     """Align every candidate to the person (no checks, no allocation).
 
     Args:
         row_moments: (P, H) vec3d from the row scan (:mod:`bodyfit.kernels.boundary`).
         target: the person's silhouette moments in this view.
         align_rotation: also rotate (else translate only).
+        vertical_anchor: ``"centroid"`` (the moments: the person's centroid goes to the
+            candidate's) or ``"extremes"``: the vertical shift instead puts the middle of
+            the person's top and bottom rows on the middle of the candidate's, so a
+            candidate as tall as the person matches its top and bottom rows whatever its
+            mass distribution (the horizontal shift stays the centroid's).
         transforms: (P,) mat33 output, person pixels -> candidate pixels.
         extremes: (P, 2) vec2 output, the candidate's top and bottom points, its pixels.
         areas: (P,) float32 output, silhouette pixels (0 = empty silhouette).
     """
     wp.launch(_align_kernel, dim=row_moments.shape[0], device=row_moments.device,
-              inputs=[row_moments, target, int(align_rotation)],
+              inputs=[row_moments, target, int(align_rotation),
+                      int(vertical_anchor == "extremes")],
               outputs=[transforms, extremes, areas])
 
 
 def align_label_maps(label_maps, target: SilhouetteMoments, align_rotation: bool = True,
-                     device: str = "cpu") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     device: str = "cpu", vertical_anchor: str = "centroid"
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Align candidates' label maps to the person's silhouette.
 
     Args:
         label_maps: (P, H, W) int, part labels, -1 for background.
         target: the person's :func:`silhouette_moments`.
         align_rotation: also rotate (else translate only).
+        vertical_anchor: as in :func:`launch_alignment`.
         device: where to compute.
 
     Returns:
@@ -210,5 +233,5 @@ def align_label_maps(label_maps, target: SilhouetteMoments, align_rotation: bool
     extremes = wp.empty((num, 2), dtype=wp.vec2, device=dev)
     areas = wp.empty(num, dtype=wp.float32, device=dev)
     launch_alignment(scan.row_moments, target.to_warp(), align_rotation, transforms, extremes,
-                     areas)
+                     areas, vertical_anchor)
     return transforms.numpy(), extremes.numpy(), areas.numpy()

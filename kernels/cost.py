@@ -35,6 +35,7 @@ from bodyfit.kernels.boundary import run_end, run_part, run_start, transform_poi
 
 __all__ = [
     "MATCHING_DIRECTIONS",
+    "VERTICAL_ANCHORS",
     "MATCHING_WEIGHTS",
     "TERM_NAMES",
     "CostSettings",
@@ -52,6 +53,8 @@ TERM_NAMES = PART_NAMES + ("top", "bottom")
 MATCHING_WEIGHTS = {"person_to_model": (1.0, 0.0), "model_to_person": (0.0, 1.0),
                     "symmetric": (0.5, 0.5)}
 MATCHING_DIRECTIONS = tuple(MATCHING_WEIGHTS)
+#: How candidates are shifted vertically onto the person (CostSettings.vertical_anchor).
+VERTICAL_ANCHORS = ("centroid", "extremes")
 
 PartVector = wp.types.vector(length=NUM_PARTS, dtype=wp.float32)
 
@@ -67,6 +70,9 @@ class CostSettings:
         front_weight, side_weight: the view weights of Eq. 17 (2 and 3).
         matching: one of ``MATCHING_DIRECTIONS``; the paper's is ``"person_to_model"``.
         align_rotation: rotate as well as translate each candidate onto the person.
+        vertical_anchor: how the vertical shift is found: ``"centroid"`` (the paper's
+            normalisation by the silhouettes' moments) or ``"extremes"`` (the middle of the
+            top and bottom rows; :func:`bodyfit.kernels.alignment.launch_alignment`).
     """
 
     part_weights: tuple[float, ...] = (2.0, 5.0, 5.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0)
@@ -76,6 +82,7 @@ class CostSettings:
     side_weight: float = 3.0
     matching: str = "person_to_model"
     align_rotation: bool = True
+    vertical_anchor: str = "centroid"
 
     def __post_init__(self):
         if len(self.part_weights) != NUM_PARTS:
@@ -85,6 +92,9 @@ class CostSettings:
                    self.side_weight)
         if any(not w >= 0 for w in weights):
             raise ValueError("cost weights must be >= 0")
+        if self.vertical_anchor not in VERTICAL_ANCHORS:
+            raise ValueError(f"vertical_anchor must be one of {VERTICAL_ANCHORS}, "
+                             f"got {self.vertical_anchor!r}")
         if self.matching not in MATCHING_DIRECTIONS:
             raise ValueError(f"matching must be one of {MATCHING_DIRECTIONS}, "
                              f"got {self.matching!r}")

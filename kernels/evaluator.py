@@ -225,7 +225,7 @@ class PopulationEvaluator:
         row_sums, row_pixels = state.row_sums[:num], state.row_pixels[:num]
         launch_row_scan(keys, scan)
         launch_alignment(scan.row_moments, state.moments, self.settings.align_rotation,
-                         transforms, extremes, areas)
+                         transforms, extremes, areas, self.settings.vertical_anchor)
         if state.params.person_to_model > 0:
             launch_nearest(scan, view.boundary_points, transforms, distances, parts)
         if state.params.model_to_person > 0:

@@ -139,7 +139,8 @@ def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) 
     moments = silhouette_moments(label_map >= 0)
     if moments.area_px == 0:
         return np.full(len(TERM_NAMES), np.inf)
-    to_candidate = rigid_transform(moments, view.moments, settings.align_rotation)
+    to_candidate = rigid_transform(moments, view.moments, settings.align_rotation,
+                                   settings.vertical_anchor)
     to_person = np.linalg.inv(to_candidate)
     rows, cols = np.nonzero(boundary_mask(label_map >= 0))
     model_points = np.stack([cols, rows], axis=1).astype(np.float64)

@@ -55,13 +55,15 @@ def test_alignment_recovers_a_known_rotation_and_shift(person_and_moved):
         assert np.allclose(ext, [moments.top, moments.bottom], atol=1e-3)
 
 
-def test_kernel_alignment_equals_numpy_reference(person_and_moved):
+@pytest.mark.parametrize("anchor", ["centroid", "extremes"])
+def test_kernel_alignment_equals_numpy_reference(person_and_moved, anchor):
     person, moved = person_and_moved
     target = silhouette_moments(person >= 0)
     for rotate in (True, False):
-        transforms = align_label_maps(moved, target, align_rotation=rotate)[0]
+        transforms = align_label_maps(moved, target, align_rotation=rotate,
+                                      vertical_anchor=anchor)[0]
         for labels, transform in zip(moved, transforms):
-            expected = rigid_transform(silhouette_moments(labels >= 0), target, rotate)
+            expected = rigid_transform(silhouette_moments(labels >= 0), target, rotate, anchor)
             assert np.allclose(transform, expected, atol=2e-3)
     translation_only = align_label_maps(moved, target, align_rotation=False)[0]
     assert np.allclose(translation_only[:, :2, :2], np.eye(2))
@@ -72,3 +74,20 @@ def test_empty_silhouette_has_zero_area(person_and_moved):
     _, _, areas = align_label_maps(np.full((1, 8, 8), -1, np.int8),
                                    silhouette_moments(person >= 0))
     assert areas[0] == 0
+
+
+def test_extremes_anchor_puts_the_middle_rows_together(person_and_moved):
+    """With the vertical anchor on the extremes, the middle of the person's top and bottom
+    rows lands on the middle of the candidate's (at the person's centroid column), while the
+    horizontal shift stays the centroid's."""
+    person, moved = person_and_moved
+    target = silhouette_moments(person >= 0)
+    by_centroid = align_label_maps(moved, target, align_rotation=False)[0]
+    by_extremes = align_label_maps(moved, target, align_rotation=False,
+                                   vertical_anchor="extremes")[0]
+    for labels, centroid, extremes in zip(moved, by_centroid, by_extremes):
+        candidate = silhouette_moments(labels >= 0)
+        middle = np.array([target.centroid[0], (target.top[1] + target.bottom[1]) / 2, 1.0])
+        assert (extremes @ middle)[1] == pytest.approx(
+            (candidate.top[1] + candidate.bottom[1]) / 2, abs=1e-3)
+        assert extremes[0, 2] == pytest.approx(centroid[0, 2], abs=1e-4)

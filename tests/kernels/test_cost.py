@@ -43,10 +43,11 @@ def candidates(truth):
     return np.concatenate([truth[0], betas]), np.concatenate([truth[1], pose])
 
 
-@pytest.mark.parametrize("matching", MATCHING_DIRECTIONS)
+@pytest.mark.parametrize("matching,anchor", [(m, "centroid") for m in MATCHING_DIRECTIONS]
+                         + [("person_to_model", "extremes"), ("symmetric", "extremes")])
 def test_cost_terms_equal_the_numpy_formula(body_model, model_arrays, views, candidates,
-                                            matching):
-    settings = CostSettings(matching=matching)
+                                            matching, anchor):
+    settings = CostSettings(matching=matching, vertical_anchor=anchor)
     costs, part_costs = evaluate_population(model_arrays, views, *candidates, settings)
     expected = np.zeros_like(part_costs, dtype=np.float64)
     for view, camera, width in zip(views, (front_camera(), side_camera()),
