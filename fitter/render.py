@@ -14,7 +14,8 @@ import numpy as np
 
 from bodyfit.fitter.body_model import PART_NAMES
 
-__all__ = ["PART_COLOURS_BGR", "render_parts", "render_pinhole", "pinhole_pixels",
+__all__ = ["PART_COLOURS_BGR", "render_parts", "orthographic_pixels", "render_pinhole",
+           "pinhole_pixels",
            "coverage_mask", "parts_legend", "labelled_grid"]
 
 #: One BGR colour per part, ``PART_NAMES`` order.
@@ -51,12 +52,20 @@ def render_parts(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray
         (height_px, W, 3) uint8 BGR image on white, W fitted to the body.
     """
     right, toward = _VIEWS[view]
-    u, z, depth = vertices @ right, vertices[:, 2], vertices @ toward
-    scale = (height_px - 2 * margin_px) / np.ptp(z)
-    px = np.stack([(u - u.min()) * scale + margin_px, (z.max() - z) * scale + margin_px], 1)
+    px = orthographic_pixels(vertices, view, height_px, margin_px)
     width = int(np.ceil(px[:, 0].max())) + margin_px
     image = np.full((height_px, width, 3), 255, np.uint8)
-    return _paint(image, px, depth, vertices, faces, face_parts, toward)
+    return _paint(image, px, vertices @ toward, vertices, faces, face_parts, toward)
+
+
+def orthographic_pixels(vertices: np.ndarray, view: str, height_px: int,
+                        margin_px: int) -> np.ndarray:
+    """(V, 2) float pixel coordinates of :func:`render_parts`' picture: the body scaled to
+    ``height_px - 2 margin_px`` pixels tall, ``margin_px`` from the top and the left."""
+    right, _ = _VIEWS[view]
+    u, z = vertices @ right, vertices[:, 2]
+    scale = (height_px - 2 * margin_px) / np.ptp(z)
+    return np.stack([(u - u.min()) * scale + margin_px, (z.max() - z) * scale + margin_px], 1)
 
 
 def render_pinhole(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray,

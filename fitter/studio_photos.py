@@ -35,7 +35,8 @@ from bodyfit.calib.camera import Camera, camera_fields
 from bodyfit.fitter.body_model import PART_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.pinhole_canvas import Placement
-from bodyfit.fitter.render import coverage_mask, pinhole_pixels, render_parts, render_pinhole
+from bodyfit.fitter.render import (coverage_mask, orthographic_pixels, pinhole_pixels,
+                                   render_parts, render_pinhole)
 from bodyfit.fitter.side_arms import side_photo_pose
 
 BACKDROP_BGR = (170, 185, 200)
@@ -46,15 +47,17 @@ def photo(vertices, model, view: str, parts, body_px: int = 700,
           size_px: tuple[int, int] = (600, 800)) -> np.ndarray:
     """(H, W, 3) uint8 BGR photo of posed ``vertices`` (V, 3) metres, one view."""
     keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in parts])
-    image = render_parts(vertices, model.faces[keep], model.face_parts[keep], view, body_px,
-                         margin_px=0)
+    faces = model.faces[keep]
+    image = render_parts(vertices, faces, model.face_parts[keep], view, body_px, margin_px=0)
+    h, w = image.shape[:2]
+    # the person's pixels: those the body covers by more than half (OpenCV's polygon fill
+    # of the painted picture takes every pixel it touches, a pixel too wide)
+    body = coverage_mask(orthographic_pixels(vertices, view, body_px, 0), faces, (w, h))
     if view == "side":  # render_parts draws the side view mirrored
-        image = image[:, ::-1]
+        image, body = image[:, ::-1], body[:, ::-1]
     width, height = size_px
     canvas = np.full((height, width, 3), BACKDROP_BGR, np.uint8)
-    h, w = image.shape[:2]
     top, left = (height - h) // 2, (width - w) // 2
-    body = image.min(axis=2) < 250
     canvas[top:top + h, left:left + w][body] = image[body]
     return canvas
 
