@@ -97,6 +97,10 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--matching",
                      help="boundary matching direction: person_to_model (the paper's, "
                           "default), model_to_person or symmetric")
+    run.add_argument("--vertical-anchor", choices=("centroid", "extremes"),
+                     help="how candidates are shifted vertically onto the person: centroid "
+                          "(the paper's moments) or extremes (the middle of the top and "
+                          "bottom rows)")
     run.add_argument("--side-arms", choices=("down", "hidden"),
                      help="the side view's candidates: down (default) with their arms "
                           "hanging down, as the side photo shows them; hidden: without arms "
@@ -215,8 +219,8 @@ def _run_settings(args):
     if given.get("free_stature"):
         search = dataclasses.replace(search, condition_stature=False)
     cost = settings.cost
-    if "matching" in given:
-        cost = dataclasses.replace(cost, matching=args.matching)
+    cost = dataclasses.replace(cost, **{k: given[k] for k in ("matching", "vertical_anchor")
+                                        if k in given})
     if "weights" in given or "weight" in given:
         if "weights" in given or args.config is None:
             cost = cost_settings(given.get("weights", "paper"), given.get("weight", []), cost)
