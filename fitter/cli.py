@@ -65,6 +65,11 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--config", type=Path, metavar="run.json",
                      help="repeat a previous run: its inputs and settings from its run.json "
                           "(the options given here override them)")
+    run.add_argument("--method", choices=("bodyfit", "paper"),
+                     help="bodyfit (default: CMA-ES 30 x 200, stature-conditioned candidates, "
+                          "symmetric matching, bodyfit weights) or paper (the paper's method "
+                          "exactly: its GA 30 x 25, Table 2 weights, person-to-model "
+                          "matching); the options below override single settings")
     run.add_argument("--front", metavar="PHOTO", help="front photo, A-pose (required "
                      "without --config)")
     run.add_argument("--side", metavar="PHOTO",
@@ -90,26 +95,28 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--sex", choices=("female", "male", "unknown"),
                      help="recorded with the run (default unknown)")
     run.add_argument("--weights", metavar="PRESET|FILE.toml",
-                     help="cost weights: paper (Table 2, default), uniform, lower-body, "
-                          "or a .toml file")
+                     help="cost weights: bodyfit (Table 2 without the top and bottom "
+                          "terms; the default), paper (Table 2; the paper method's), "
+                          "uniform, lower-body, or a .toml file")
     run.add_argument("--weight", action="append", metavar="NAME=VALUE",
                      help="override one weight, e.g. waist=8 or view.side=3 (repeatable)")
     run.add_argument("--matching",
-                     help="boundary matching direction: person_to_model (the paper's, "
-                          "default), model_to_person or symmetric")
+                     help="boundary matching direction: symmetric (default), "
+                          "person_to_model (the paper's) or model_to_person")
     run.add_argument("--vertical-anchor", choices=("centroid", "extremes"),
                      help="how candidates are shifted vertically onto the person: centroid "
                           "(the paper's moments) or extremes (the middle of the top and "
-                          "bottom rows)")
+                          "bottom rows; the default)")
     run.add_argument("--side-arms", choices=("down", "hidden"),
                      help="the side view's candidates: down (default) with their arms "
                           "hanging down, as the side photo shows them; hidden: without arms "
                           "(for a side photo whose arms hide within the torso)")
     run.add_argument("--optimizer", choices=("ga", "cmaes"),
-                     help="ga: the paper's genetic algorithm (default); cmaes: CMA-ES")
+                     help="cmaes: CMA-ES (default); ga: the paper's genetic algorithm")
     run.add_argument("--population", type=int, help="candidates per generation "
-                     "(default: ga 30, cmaes its own)")
-    run.add_argument("--generations", type=int, help="generations (default: ga 25)")
+                     "(default 30)")
+    run.add_argument("--generations", type=int,
+                     help="generations (default 200; --method paper: 25)")
     run.add_argument("--components", type=int,
                      help="shape components searched (default 20, as the paper; up to 60)")
     run.add_argument("--seed", type=int, help="random seed (default 0)")
@@ -194,7 +201,7 @@ def _run_settings(args):
     or with --config the run.json's values, overridden by every option given."""
     import dataclasses
 
-    from bodyfit.fitter.fit import FitSettings
+    from bodyfit.fitter.fit import METHOD_WEIGHTS, METHODS
     from bodyfit.fitter.person import PersonInputs
     from bodyfit.fitter.run_config import read_run_config
     from bodyfit.fitter.weights import (cost_settings, parse_override, settings_from_record,
@@ -207,7 +214,10 @@ def _run_settings(args):
         if missing:
             raise UserError(f"fitter run needs {', '.join(missing)} (or --config run.json)")
         inputs = PersonInputs(args.front, args.side, args.height_cm)
-        settings, output = FitSettings(), args.output
+        settings, output = METHODS[args.method or "bodyfit"], args.output
+    elif args.method is not None:
+        raise UserError("--method and --config cannot go together: the run.json holds the "
+                        "method's settings")
     else:
         config = read_run_config(args.config)
         inputs, settings, output = config.inputs, config.settings, args.output or config.output
@@ -223,7 +233,8 @@ def _run_settings(args):
                                         if k in given})
     if "weights" in given or "weight" in given:
         if "weights" in given or args.config is None:
-            cost = cost_settings(given.get("weights", "paper"), given.get("weight", []), cost)
+            cost = cost_settings(given.get("weights", METHOD_WEIGHTS[args.method or "bodyfit"]),
+                                 given.get("weight", []), cost)
         else:  # --weight on top of the recorded weights
             record = weights_record(cost) | dict(map(parse_override, args.weight))
             cost = settings_from_record(record, cost)

@@ -24,7 +24,7 @@ from bodyfit.fitter.search import SearchResult, SearchSettings, search
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, stature_scale
 
-__all__ = ["FitSettings", "Fit", "fit_person"]
+__all__ = ["FitSettings", "METHODS", "METHOD_WEIGHTS", "Fit", "fit_person"]
 
 _SPREAD_SHARE = 0.25
 _SPREAD_MIN = 3
@@ -37,7 +37,8 @@ class FitSettings:
     Attributes:
         search: optimiser and space.
         canvas: canvas geometry.
-        cost: the kernels' weights and matching (the paper's Table 2 by default).
+        cost: the kernels' weights, matching and alignment (default: the ``bodyfit``
+            weights preset, symmetric matching, the vertical anchor on the extremes).
         device: where the kernels run, "cpu" or "cuda:0".
         side_arms: how the side view treats the person's arms, one of
             ``bodyfit.fitter.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
@@ -48,11 +49,25 @@ class FitSettings:
 
     search: SearchSettings = SearchSettings()
     canvas: CanvasSettings = CanvasSettings()
-    cost: kernels.CostSettings = kernels.CostSettings()
+    cost: kernels.CostSettings = kernels.CostSettings(
+        matching="symmetric", vertical_anchor="extremes", top_weight=0.0, bottom_weight=0.0)
     device: str = "cpu"
     side_arms: str = "down"
     projection: str = "orthographic"
 
+
+#: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
+#: docs/fitter.md "Choosing the defaults") and the paper's method exactly (Sections
+#: 3.3-3.4): its GA at 30 x 25 over all 20 betas and the 4 angles, Table 2's weights, the
+#: person -> model matching, the moments' alignment.
+METHODS = {
+    "bodyfit": FitSettings(),
+    "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
+                                               generations=None, condition_stature=False),
+                         cost=kernels.CostSettings()),
+}
+#: The weights preset (:data:`bodyfit.fitter.weights.PRESETS`) of each method's cost.
+METHOD_WEIGHTS = {"bodyfit": "bodyfit", "paper": "paper"}
 
 @dataclasses.dataclass(frozen=True)
 class Fit:

@@ -28,9 +28,12 @@ class SearchSettings:
     """How the body space is searched.
 
     Attributes:
-        optimizer: one of ``OPTIMIZER_NAMES`` (``"ga"``: the paper's genetic algorithm).
-        population: candidates per generation (None: the optimiser's default).
-        generations: generations at most (None: the optimiser's default, the paper's 25).
+        optimizer: one of ``OPTIMIZER_NAMES`` (``"ga"``: the paper's genetic algorithm;
+            default ``"cmaes"``, chosen by measured error: docs/fitter.md).
+        population: candidates per generation (None: the optimiser's default, the GA's
+            is the paper's 30).
+        generations: generations at most (None: the optimiser's default, the GA's is the
+            paper's 25).
         components: K, shape components searched (the paper: 20; up to those stored).
         beta_limit: betas lie within +-this many standard deviations (the paper: 3).
         pose_lower_deg, pose_upper_deg: bounds of the four abduction angles, degrees
@@ -42,9 +45,9 @@ class SearchSettings:
             searches it).
     """
 
-    optimizer: str = "ga"
-    population: int | None = None
-    generations: int | None = None
+    optimizer: str = "cmaes"
+    population: int | None = 30
+    generations: int | None = 200
     components: int = 20
     beta_limit: float = 3.0
     pose_lower_deg: tuple[float, ...] = (-10.0,) * len(POSE_NAMES)

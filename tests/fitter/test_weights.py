@@ -34,6 +34,7 @@ def _one_line_error(call, *match):
 
 def test_presets_have_the_documented_values():
     assert PRESETS["paper"] == TABLE_2
+    assert PRESETS["bodyfit"] == {**TABLE_2, "top": 0, "bottom": 0}
     assert PRESETS["uniform"] == dict.fromkeys(WEIGHT_NAMES, 1.0)
     assert PRESETS["lower-body"] == {
         "head": 1, "chest": 2, "waist": 5, "hip": 8, "leg": 6, "foot": 2, "arm": 1, "elbow": 1,
@@ -41,9 +42,12 @@ def test_presets_have_the_documented_values():
     assert list(PRESETS["paper"]) == list(WEIGHT_NAMES)
 
 
-def test_paper_preset_is_the_kernels_default():
+def test_paper_preset_is_the_kernels_default_and_bodyfit_the_fitters():
+    from bodyfit.fitter.fit import FitSettings
+
     assert cost_settings("paper") == CostSettings()
     assert weights_record(CostSettings()) == TABLE_2
+    assert weights_record(FitSettings().cost) == PRESETS["bodyfit"]
 
 
 def test_preset_settings_put_each_weight_in_its_field():
@@ -93,7 +97,8 @@ def test_degenerate_weights_are_errors():
 
 
 def test_unknown_weights_choice_is_an_error():
-    _one_line_error(lambda: resolve_weights("papers"), "paper, uniform, lower-body", "'papers'")
+    _one_line_error(lambda: resolve_weights("papers"), "paper, bodyfit, uniform, lower-body",
+                    "'papers'")
 
 
 def test_weights_file_overrides_its_preset(tmp_path):
