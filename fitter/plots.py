@@ -21,31 +21,38 @@ def _ticks(low: float, high: float, count: int = 5) -> np.ndarray:
 
 
 def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label: str,
-               size_px: tuple[int, int] = (800, 480), log_y: bool = False) -> np.ndarray:
-    """(H, W, 3) uint8 BGR chart of one or more series against their index (1, 2, ...).
+               size_px: tuple[int, int] = (800, 480), log_y: bool = False,
+               x_values: dict[str, np.ndarray] | None = None) -> np.ndarray:
+    """(H, W, 3) uint8 BGR chart of one or more series.
 
     Args:
         series: name -> (N,) float values; non-finite values are left out.
         title, x_label, y_label: texts.
         size_px: (width, height).
         log_y: logarithmic y axis (values must then be > 0).
+        x_values: name -> (N,) x of each value, the points then marked; None: the values'
+            index 1, 2, ... (a generation, say).
     """
     width, height = size_px
     left, right, top, bottom = 80, 20, 40, 50
     image = np.full((height, width, 3), 255, np.uint8)
-    values = [np.asarray(v, np.float64) for v in series.values()]
-    finite = np.concatenate([v[np.isfinite(v) & ((v > 0) if log_y else True)] for v in values])
+    values = {name: np.asarray(v, np.float64) for name, v in series.items()}
+    xs = {name: (np.arange(1, len(v) + 1, dtype=np.float64) if x_values is None
+                 else np.asarray(x_values[name], np.float64)) for name, v in values.items()}
+    shown = {name: np.isfinite(v) & ((v > 0) if log_y else True) for name, v in values.items()}
+    finite = np.concatenate([v[shown[name]] for name, v in values.items()])
     if finite.size == 0:
         raise ValueError("line_chart needs at least one finite value")
     scale = np.log10 if log_y else (lambda v: v)
     y_low, y_high = scale(finite.min()), scale(finite.max())
     if y_high - y_low < 1e-9:
         y_low, y_high = y_low - 1, y_high + 1
-    n = max(len(v) for v in values)
+    all_x = np.concatenate(list(xs.values()))
+    x_low, x_high = (1.0, max(2.0, all_x.max())) if x_values is None else (0.0, all_x.max())
 
-    def to_px(i, y):
-        x = left + (i - 1) / max(1, n - 1) * (width - left - right)
-        return int(round(x)), int(round(top + (y_high - y) / (y_high - y_low) * (height - top - bottom)))
+    def to_px(x, y):
+        px = left + (x - x_low) / (x_high - x_low) * (width - left - right)
+        return int(round(px)), int(round(top + (y_high - y) / (y_high - y_low) * (height - top - bottom)))
 
     cv2.rectangle(image, (left, top), (width - right, height - bottom), (0, 0, 0), 1)
     if log_y:  # 1-2-5 steps per decade
@@ -55,24 +62,25 @@ def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label:
         ticks = _ticks(y_low, y_high)
     for y in ticks:
         if y_low - 1e-9 <= y <= y_high + 1e-9:
-            _, py = to_px(1, y)
+            _, py = to_px(x_low, y)
             cv2.line(image, (left, py), (width - right, py), (225, 225, 225), 1)
             text = f"{10 ** y:g}" if log_y else f"{y:g}"
             cv2.putText(image, text, (8, py + 5), _FONT, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
-    for i in _ticks(1, n):
-        if 1 <= i <= n and float(i).is_integer():
-            px, _ = to_px(i, y_low)
-            cv2.putText(image, f"{int(i)}", (px - 8, height - bottom + 18), _FONT, 0.45,
+    for x in _ticks(x_low, x_high):
+        if x_low <= x <= x_high and (x_values is not None or float(x).is_integer()):
+            px, _ = to_px(x, y_low)
+            cv2.putText(image, f"{x:g}", (px - 8, height - bottom + 18), _FONT, 0.45,
                         (0, 0, 0), 1, cv2.LINE_AA)
-    for index, (name, v) in enumerate(series.items()):
+    for index, (name, v) in enumerate(values.items()):
         colour = _COLOURS_BGR[index % len(_COLOURS_BGR)]
-        ok = np.isfinite(v) & ((v > 0) if log_y else True)
-        points = np.array([to_px(i + 1, scale(y)) for i, y in enumerate(v) if ok[i]], np.int32)
+        points = np.array([to_px(x, scale(y)) for x, y, ok in zip(xs[name], v, shown[name])
+                           if ok], np.int32)
         if len(points) > 1:
             cv2.polylines(image, [points], False, colour, 2, cv2.LINE_AA)
-        elif len(points) == 1:
-            cv2.circle(image, tuple(int(c) for c in points[0]), 3, colour, cv2.FILLED)
-        cv2.putText(image, name, (width - right - 200, top + 22 + 20 * index), _FONT, 0.5,
+        if x_values is not None or len(points) == 1:
+            for point in points:
+                cv2.circle(image, tuple(int(c) for c in point), 4, colour, cv2.FILLED)
+        cv2.putText(image, name, (width - right - 260, top + 22 + 20 * index), _FONT, 0.5,
                     colour, 1, cv2.LINE_AA)
     title_width = cv2.getTextSize(title, _FONT, 0.6, 1)[0][0]
     cv2.putText(image, title, ((width - title_width) // 2, 22), _FONT, 0.6, (0, 0, 0), 1,

@@ -1,14 +1,15 @@
 """Benchmark of `fitter run`: measurement error against time, per search setting.
 
     python tools/bench_fitter.py                    # 4 subjects, the settings below
-    python tools/bench_fitter.py --subjects 8 --seed 3
+    python tools/bench_fitter.py --subjects 8 --seed 3 --plot docs/fitter_error_vs_time.png
 
 In-space subjects: bodies drawn from the model's own 20-component space (betas normal,
-clipped at +-2 sigma; limbs 2-8 degrees out), photographed front and side by
-:mod:`bodyfit.fitter.studio_photos` (a painter's renderer, not the kernels; orthographic,
-700 px tall), then fitted by the `fitter run` command itself, start-up included, once per
-setting. Error: |fitted - true| of the 16 measurements, mm. Prints Markdown (docs/fitter.md
-holds the output).
+clipped at +-2 sigma; limbs 2-8 degrees out), photographed front and side (the side
+with the arms hanging down) by :mod:`bodyfit.fitter.studio_photos` (a painter's renderer,
+not the kernels; orthographic, 700 px tall), then fitted by the `fitter run` command
+itself, start-up included, once per setting. Error: |fitted - true| of the 16
+measurements, mm. Prints Markdown (docs/fitter.md holds the output) and writes the
+error-against-time plot.
 """
 
 from __future__ import annotations
@@ -25,28 +26,40 @@ from pathlib import Path
 
 import numpy as np
 
+from bodyfit.calib.images import write_image
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model_cache import load_model
+from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.studio_photos import write_subject
 
-#: name -> `fitter run` options; the first is the paper's method and budget. Unless said,
-#: the first shape component is solved from the stature (bodyfit.fitter.stature).
+#: name -> `fitter run` options: the paper's method and bodyfit's defaults at several
+#: budgets (candidates = population x generations), for error against time.
 SETTINGS = {
-    "paper: GA 30 x 25, stature searched": ["--optimizer", "ga", "--free-stature"],
-    "GA 30 x 25": ["--optimizer", "ga"],
-    "CMA-ES 30 x 100": ["--optimizer", "cmaes", "--population", "30", "--generations", "100"],
-    "CMA-ES 60 x 150, symmetric, stature searched": [
-        "--optimizer", "cmaes", "--population", "60", "--generations", "150",
-        "--matching", "symmetric", "--free-stature"],
-    "CMA-ES 60 x 150, symmetric": ["--optimizer", "cmaes", "--population", "60",
-                                   "--generations", "150", "--matching", "symmetric"],
+    "paper: GA 30 x 25": ["--method", "paper"],
+    "paper: GA 30 x 200": ["--method", "paper", "--generations", "200"],
+    "bodyfit: CMA-ES 30 x 50": ["--generations", "50"],
+    "bodyfit: CMA-ES 30 x 100": ["--generations", "100"],
+    "bodyfit (default): CMA-ES 30 x 200": [],
+    "bodyfit: CMA-ES 30 x 400": ["--generations", "400"],
 }
+#: The curves of the error-against-time plot: name -> the settings on it.
+CURVES = {"paper's method (GA)": [name for name in SETTINGS if name.startswith("paper")],
+          "bodyfit (CMA-ES)": [name for name in SETTINGS if name.startswith("bodyfit")]}
+
+
+def _candidates(options: list[str]) -> int:
+    paper = "paper" in options
+    generations = int(options[options.index("--generations") + 1]) \
+        if "--generations" in options else (25 if paper else 200)
+    return 30 * generations
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--subjects", type=int, default=4)
     parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--plot", type=Path, default=Path("docs/fitter_error_vs_time.png"),
+                        help="error-against-time plot to write")
     args = parser.parse_args()
     model = load_model()
     rng = np.random.default_rng(args.seed)
@@ -80,12 +93,18 @@ def main() -> None:
     print("|---|---|---|---|" + "---|" * (len(IMPORTANT) + 1))
     for name, options in SETTINGS.items():
         err = np.abs(np.array(errors[name]))
-        pop = int(options[options.index("--population") + 1]) if "--population" in options else 30
-        gens = int(options[options.index("--generations") + 1]) if "--generations" in options else 25
-        print(f"| {name} | {pop * gens} | {np.mean(seconds[name]):.1f} | "
+        print(f"| {name} | {_candidates(options)} | {np.mean(seconds[name]):.1f} | "
               f"{err[:, important].mean():.1f} | "
               + " | ".join(f"{err[:, i].mean():.1f}" for i in important)
               + f" | {err[:, keys.index('O')].mean():.1f} |")
+    mean7 = {name: np.abs(np.array(errors[name]))[:, important].mean() for name in SETTINGS}
+    chart = line_chart({curve: [mean7[n] for n in names] for curve, names in CURVES.items()},
+                       f"fitter run, {args.subjects} in-space subjects", "wall seconds per subject",
+                       "7 important measurements, mean abs. error (mm)", log_y=True,
+                       x_values={curve: [np.mean(seconds[n]) for n in names]
+                                 for curve, names in CURVES.items()})
+    write_image(args.plot, chart)
+    print(f"\nPlot: `{args.plot}`.")
     sys.stdout.flush()
 
 
