@@ -1,0 +1,107 @@
+"""Ablations of `fitter run`'s defaults: each row changes one choice, same subjects, seeds.
+
+    python tools/bench_choices.py                       # 4 subjects, CMA-ES 30 x 100
+    python tools/bench_choices.py --subjects 6 --generations 200
+
+In-space subjects as tools/bench_fitter.py draws them (studio photos, the side with the
+arms down), fitted through `fitter run`'s own path (calib's silhouettes, then
+``fit_person``). Besides the measurement errors it reports the cost of the found body and
+of the true one (its betas and front pose; with the stature conditioned, the true body as
+the conditioning makes it: the same shape stood as tall as the stature) on the same
+canvases: a found cost below the truth's means the cost's minimum is not at the truth (a
+bias of the cost or the photos); above it, that the search stopped short. Prints Markdown.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bodyfit import kernels
+from bodyfit.fitter.fit import FitSettings, fit_person
+from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
+from bodyfit.fitter.model_cache import load_model
+from bodyfit.fitter.person import PersonInputs, person_masks
+from bodyfit.fitter.stature import StatureConditioner
+from bodyfit.fitter.studio_photos import write_subject
+from bodyfit.fitter.weights import cost_settings
+
+
+def _variants(base: FitSettings) -> dict[str, FitSettings]:
+    """Row name -> settings: the defaults, then one choice changed per row."""
+    replace = dataclasses.replace
+    return {
+        "defaults": base,
+        "vertical anchor on the centroid": replace(
+            base, cost=replace(base.cost, vertical_anchor="centroid")),
+        "person -> model matching": replace(
+            base, cost=replace(base.cost, matching="person_to_model")),
+        "paper weights (top, bottom 5)": replace(
+            base, cost=cost_settings("paper", (), base.cost)),
+        "stature searched": replace(
+            base, search=replace(base.search, condition_stature=False)),
+    }
+
+
+def _true_cost(model, fit, settings: FitSettings, betas, pose, stature_m) -> float:
+    s = settings.search
+    if s.condition_stature:
+        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit,
+                                         s.pose_lower_deg, s.pose_upper_deg)
+        betas = conditioner.complete(betas[None, 1:], pose[None])[0]
+    arrays = kernels.ModelArrays.from_body_model(model, s.components)
+    evaluator = kernels.PopulationEvaluator(arrays, list(fit.views.values()), settings.cost)
+    return float(evaluator.evaluate(betas[None], pose[None]).costs[0])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--subjects", type=int, default=4)
+    parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--generations", type=int, default=100)
+    args = parser.parse_args()
+    model = load_model()
+    base = FitSettings()
+    base = dataclasses.replace(base, search=dataclasses.replace(
+        base.search, generations=args.generations))
+    variants = _variants(base)
+    rng = np.random.default_rng(args.seed)
+    rows = {name: {"err": [], "found": [], "true": [], "s": []} for name in variants}
+    keys = list(MEASUREMENTS)
+    with tempfile.TemporaryDirectory() as scratch:
+        for i in range(args.subjects):
+            folder = Path(scratch) / f"s{i}"
+            folder.mkdir()
+            betas, pose = np.clip(rng.standard_normal(20), -2, 2), rng.uniform(2, 8, 4)
+            truth = write_subject(folder, model, betas, pose)
+            stature_m = truth["O"] / 1000
+            masks = person_masks(PersonInputs(str(folder / "front.png"),
+                                              str(folder / "side.png"), truth["O"] / 10))
+            for name, settings in variants.items():
+                start = time.perf_counter()
+                fit = fit_person(model, masks, stature_m, settings, progress=False)
+                rows[name]["s"].append(time.perf_counter() - start)
+                rows[name]["err"].append([fit.measurements[k] - truth[k] for k in keys])
+                rows[name]["found"].append(fit.search.cost)
+                rows[name]["true"].append(_true_cost(model, fit, settings, betas, pose,
+                                                     stature_m))
+    important = [keys.index(k) for k in IMPORTANT]
+    print(f"`python tools/bench_choices.py --subjects {args.subjects} --seed {args.seed} "
+          f"--generations {args.generations}` on {time.strftime('%Y-%m-%d')}: CMA-ES "
+          f"{base.search.population} x {args.generations}, search seed 0, on the CPU.\n")
+    print("| choice | fit s (mean) | found cost | true body's cost | 7 important, mean abs. "
+          "error (mm) | their mean signed error (mm) |")
+    print("|---|---|---|---|---|---|")
+    for name, row in rows.items():
+        err = np.array(row["err"])[:, important]
+        print(f"| {name} | {np.mean(row['s']):.1f} | {np.mean(row['found']):.1f} | "
+              f"{np.mean(row['true']):.1f} | {np.abs(err).mean():.1f} | {err.mean():+.1f} |")
+
+
+if __name__ == "__main__":
+    main()
