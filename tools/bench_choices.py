@@ -9,7 +9,8 @@ arms down), fitted through `fitter run`'s own path (calib's silhouettes, then
 of the true one (its betas and front pose; with the stature conditioned, the true body as
 the conditioning makes it: the same shape stood as tall as the stature) on the same
 canvases: a found cost below the truth's means the cost's minimum is not at the truth (a
-bias of the cost or the photos); above it, that the search stopped short. Prints Markdown.
+bias of the cost or the photos); above it, that the search stopped short. The last
+column is how often the truth lies within the reported +- spread. Prints Markdown.
 """
 
 from __future__ import annotations
@@ -71,7 +72,8 @@ def main() -> None:
         base.search, generations=args.generations))
     variants = _variants(base)
     rng = np.random.default_rng(args.seed)
-    rows = {name: {"err": [], "found": [], "true": [], "s": []} for name in variants}
+    rows = {name: {"err": [], "spread": [], "found": [], "true": [], "s": []}
+            for name in variants}
     keys = list(MEASUREMENTS)
     with tempfile.TemporaryDirectory() as scratch:
         for i in range(args.subjects):
@@ -87,6 +89,7 @@ def main() -> None:
                 fit = fit_person(model, masks, stature_m, settings, progress=False)
                 rows[name]["s"].append(time.perf_counter() - start)
                 rows[name]["err"].append([fit.measurements[k] - truth[k] for k in keys])
+                rows[name]["spread"].append([fit.spreads[k] for k in keys])
                 rows[name]["found"].append(fit.search.cost)
                 rows[name]["true"].append(_true_cost(model, fit, settings, betas, pose,
                                                      stature_m))
@@ -95,12 +98,15 @@ def main() -> None:
           f"--generations {args.generations}` on {time.strftime('%Y-%m-%d')}: CMA-ES "
           f"{base.search.population} x {args.generations}, search seed 0, on the CPU.\n")
     print("| choice | fit s (mean) | found cost | true body's cost | 7 important, mean abs. "
-          "error (mm) | their mean signed error (mm) |")
-    print("|---|---|---|---|---|---|")
+          "error (mm) | their mean signed error (mm) | truth within +- spread (16) |")
+    print("|---|---|---|---|---|---|---|")
     for name, row in rows.items():
-        err = np.array(row["err"])[:, important]
+        err = np.array(row["err"])
+        inside = np.abs(err) <= np.array(row["spread"])
+        err = err[:, important]
         print(f"| {name} | {np.mean(row['s']):.1f} | {np.mean(row['found']):.1f} | "
-              f"{np.mean(row['true']):.1f} | {np.abs(err).mean():.1f} | {err.mean():+.1f} |")
+              f"{np.mean(row['true']):.1f} | {np.abs(err).mean():.1f} | {err.mean():+.1f} | "
+              f"{inside.mean():.0%} |")
 
 
 if __name__ == "__main__":
