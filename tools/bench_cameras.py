@@ -16,10 +16,8 @@ the measurements, mm. Prints Markdown (docs/fitter.md, Cameras, holds the output
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
-import subprocess
 import sys
 import tempfile
 import time
@@ -30,6 +28,7 @@ import numpy as np
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.studio_photos import write_pinhole_subject
+from bench_subjects import draw_subject, fit_by_command
 
 SIZE_PX = (1500, 2000)
 #: The true camera: a 28 mm-equivalent phone camera (66 degrees across the long side),
@@ -66,8 +65,7 @@ def main() -> None:
         for i in range(args.subjects):
             folder = Path(scratch) / f"s{i}"
             folder.mkdir()
-            betas = np.clip(rng.standard_normal(20), -2, 2)
-            pose = rng.uniform(2, 8, 4)
+            betas, pose = draw_subject(rng)
             distance, height = rng.uniform(2.5, 3.5), rng.uniform(1.0, 1.5)
             scenes.append(f"{distance:.2f} m / {height:.2f} m")
             truth = write_pinhole_subject(folder, model, betas, pose, true_intrinsics(), SIZE_PX,
@@ -75,15 +73,9 @@ def main() -> None:
             for name, options in SETTINGS.items():
                 out = folder / f"out{list(SETTINGS).index(name)}"
                 options = [o.format(camera=folder / "camera.json") for o in options]
-                start = time.perf_counter()
-                subprocess.run(["fitter", "-q", "run", "--front", str(folder / "front.png"),
-                                "--side", str(folder / "side.png"), "--height-cm",
-                                f"{truth['O'] / 10:.2f}", "-o", str(out), *BUDGET, *options],
-                               check=True, stdout=subprocess.DEVNULL)
-                seconds[name].append(time.perf_counter() - start)
-                table = json.loads((out / "measurements.json").read_text())["measurements"]
-                errors[name].append([table[MEASUREMENTS[k][0]]["value_mm"] - truth[k]
-                                     for k in MEASUREMENTS])
+                wall, error = fit_by_command(folder, truth, out, [*BUDGET, *options])
+                seconds[name].append(wall)
+                errors[name].append(error)
     keys = list(MEASUREMENTS)
     important = [keys.index(k) for k in IMPORTANT]
     print(f"`python tools/bench_cameras.py --subjects {args.subjects} --seed {args.seed}` on "

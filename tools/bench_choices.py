@@ -31,6 +31,7 @@ from bodyfit.fitter.person import PersonInputs, person_masks
 from bodyfit.fitter.stature import StatureConditioner
 from bodyfit.fitter.studio_photos import write_subject
 from bodyfit.fitter.weights import cost_settings
+from bench_subjects import draw_subject
 
 
 def _variants(base: FitSettings) -> dict[str, FitSettings]:
@@ -79,7 +80,7 @@ def main() -> None:
         for i in range(args.subjects):
             folder = Path(scratch) / f"s{i}"
             folder.mkdir()
-            betas, pose = np.clip(rng.standard_normal(20), -2, 2), rng.uniform(2, 8, 4)
+            betas, pose = draw_subject(rng)
             truth = write_subject(folder, model, betas, pose)
             stature_m = truth["O"] / 1000
             masks = person_masks(PersonInputs(str(folder / "front.png"),

@@ -15,10 +15,8 @@ error-against-time plot.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
-import subprocess
 import sys
 import tempfile
 import time
@@ -31,6 +29,7 @@ from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.studio_photos import write_subject
+from bench_subjects import draw_subject, fit_by_command
 
 #: name -> `fitter run` options: the paper's method and bodyfit's defaults at several
 #: budgets (candidates = population x generations), for error against time.
@@ -69,20 +68,12 @@ def main() -> None:
         for i in range(args.subjects):
             folder = Path(scratch) / f"s{i}"
             folder.mkdir()
-            betas = np.clip(rng.standard_normal(20), -2, 2)
-            pose = rng.uniform(2, 8, 4)
-            truth = write_subject(folder, model, betas, pose)
+            truth = write_subject(folder, model, *draw_subject(rng))
             for name, options in SETTINGS.items():
-                out = folder / name.replace(" ", "_").replace(",", "")
-                start = time.perf_counter()
-                subprocess.run(["fitter", "-q", "run", "--front", str(folder / "front.png"),
-                                "--side", str(folder / "side.png"), "--height-cm",
-                                f"{truth['O'] / 10:.2f}", "-o", str(out), *options],
-                               check=True, stdout=subprocess.DEVNULL)
-                seconds[name].append(time.perf_counter() - start)
-                table = json.loads((out / "measurements.json").read_text())["measurements"]
-                errors[name].append([table[MEASUREMENTS[k][0]]["value_mm"] - truth[k]
-                                     for k in MEASUREMENTS])
+                out = folder / f"out{list(SETTINGS).index(name)}"
+                wall, error = fit_by_command(folder, truth, out, options)
+                seconds[name].append(wall)
+                errors[name].append(error)
     keys = list(MEASUREMENTS)
     important = [keys.index(k) for k in IMPORTANT]
     print(f"`python tools/bench_fitter.py --subjects {args.subjects} --seed {args.seed}` on "

@@ -37,6 +37,7 @@ from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.person import PersonInputs, person_masks
 from bodyfit.fitter.search import SearchSettings
 from bodyfit.fitter.studio_photos import write_subject
+from bench_subjects import draw_subject
 
 #: row name -> (side photo's arms, fit's --side-arms)
 ROWS = {
@@ -59,8 +60,7 @@ def main() -> None:
     search = SearchSettings(optimizer="cmaes", population=args.population,
                             generations=args.generations, seed=args.search_seed)
     rng = np.random.default_rng(args.seed)
-    subjects = [(np.clip(rng.standard_normal(20), -2, 2), rng.uniform(2, 8, 4))
-                for _ in range(args.subjects)]
+    subjects = [draw_subject(rng) for _ in range(args.subjects)]
     errors = {name: [] for name in ROWS}
     seconds = {name: [] for name in ROWS}
     with tempfile.TemporaryDirectory() as scratch:
