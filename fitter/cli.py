@@ -206,7 +206,6 @@ def _cmd_demo(args) -> None:
         run_argv += ["--generations", str(args.generations)]
     run_args = _build_parser().parse_args(run_argv)
     inputs, settings, output = _run_settings(run_args)
-    inputs.validate()
     fit, written = run_person(model, inputs, settings, output, run_args.overwrite,
                               progress=None if not args.quiet else False)
     result = fit.search
