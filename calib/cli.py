@@ -8,8 +8,6 @@ a failed command leaves no half-written file.
 from __future__ import annotations
 
 import argparse
-import datetime
-import json
 import logging
 import sys
 from pathlib import Path
@@ -19,19 +17,12 @@ import numpy as np
 
 from bodyfit.calib.boards import BoardDetector, BoardSpec, parse_board, render_board
 from bodyfit.calib.camera import load_camera
-from bodyfit.calib.capture import (
-    DISTORTION_MODELS,
-    INTRINSIC_NAMES,
-    CaptureSettings,
-    calibrate,
-    collect_views,
-    describe_views,
-)
+from bodyfit.calib.camera_capture import capture_camera
+from bodyfit.calib.capture import DISTORTION_MODELS, INTRINSIC_NAMES, CaptureSettings, describe_views
 from bodyfit.calib.check import CheckedView, check_calibration, rms_px
-from bodyfit.calib.coverage import coverage_fraction, coverage_picture
 from bodyfit.calib.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import check_writable_dir, file_sha256, write_atomic
+from bodyfit.calib.files import check_writable_dir, write_atomic
 from bodyfit.calib.images import encode_image, read_photo, to_upright, write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.calib.undistort import undistort_image
@@ -165,28 +156,9 @@ def _capture(args: argparse.Namespace, argv: list[str]) -> None:
     )
     output = Path(args.output)
     coverage_path = Path(args.coverage) if args.coverage else output.with_name(f"{output.stem}_coverage.png")
-    check_writable_dir(output.parent)
-    check_writable_dir(coverage_path.parent)
-
-    views, image_size = collect_views(args.inputs, BoardDetector(spec), settings)
-    calibration = calibrate(views, image_size, settings, spec)
-    covered = coverage_fraction(list(calibration.views), image_size)
-    record = {
-        **calibration.to_record(),
-        "coverage_fraction": covered,
-        "provenance": {
-            "argv": argv,
-            "inputs": list(args.inputs),
-            "input_sha256": [file_sha256(path) for path in args.inputs],
-            "bodyfit_version": bodyfit_version(),
-            "opencv_version": cv2.__version__,
-            "time": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        },
-    }
-    write_image(coverage_path, coverage_picture(list(calibration.views), image_size))
-    write_atomic(output, (json.dumps(record, indent=2, allow_nan=False) + "\n").encode())
-
-    print(f"board: {spec.describe()}; images {image_size[0]}x{image_size[1]} px")
+    calibration, covered = capture_camera(list(args.inputs), spec, settings, output, coverage_path, argv)
+    width, height = calibration.camera.image_size_px
+    print(f"board: {spec.describe()}; images {width}x{height} px")
     for view in calibration.views:
         detail = view.status.value
         if view.error_px is not None:

@@ -59,20 +59,30 @@ def source_coordinates(
     return ideal.reshape(height * supersampling, width * supersampling, 2)
 
 
-def distort_image(ideal_image: np.ndarray, K: np.ndarray, dist: np.ndarray) -> np.ndarray:
+def distort_image(
+    ideal_image: np.ndarray, K: np.ndarray, dist: np.ndarray, outside: float | tuple[float, ...] = 0
+) -> np.ndarray:
     """The image a distorting lens records of a scene whose pinhole image is ``ideal_image``.
 
     Args:
         ideal_image: (H, W) or (H, W, C) uint8, undistorted (pinhole) image.
         K, dist: the lens, as in :func:`source_coordinates`.
+        outside: the value (a grey level, or one per channel) of pixels whose source falls
+            outside the ideal image: black by default; a plain backdrop's colour continues it.
 
     Returns:
-        Same shape and dtype, the distorted image; pixels whose source falls outside the
-        ideal image are black. ``cv2.undistort`` (or kornia's) takes it back.
+        Same shape and dtype, the distorted image. ``cv2.undistort`` (or kornia's) takes it back.
     """
     height, width = ideal_image.shape[:2]
     source = source_coordinates(K, dist, (width, height), to_pixels=True).astype(np.float32)
-    return cv2.remap(ideal_image, source[..., 0], source[..., 1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT)
+    return cv2.remap(
+        ideal_image,
+        source[..., 0],
+        source[..., 1],
+        cv2.INTER_LINEAR,
+        borderMode=cv2.BORDER_CONSTANT,
+        borderValue=outside,
+    )
 
 
 class BoardPhotoRenderer:

@@ -48,12 +48,22 @@ def _build_parser() -> argparse.ArgumentParser:
                             "fitter/data/body_model.npz is the model bodyfit ships")
     model_sub.add_parser("info", help="print which model is used and how it was built")
 
-    demo = sub.add_parser("demo", help="built-in example: draw bodies, write meshes "
-                                       "(.obj/.ply, metres), measurements (mm) and a picture")
-    demo.add_argument("-o", "--output", type=Path, default=Path("out/demo"),
-                      help="output directory (default out/demo)")
-    demo.add_argument("--bodies", type=int, default=3, help="bodies to draw (default 3)")
-    demo.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    demo = sub.add_parser(
+        "demo", help="the main job on a synthetic person: photos and board photos through "
+                     "one phone camera, calibration, fitter run --camera, measured vs true (mm)",
+        description="Photograph a synthetic person (front, A-pose; side, arms down) and a "
+                    "chessboard through one synthetic phone camera with lens distortion, "
+                    "calibrate it as calib capture does, fit the person as fitter run "
+                    "--camera does, and print the 16 fitted measurements against the true "
+                    "ones (mm). Writes the photos, camera.json, truth.json and the fit "
+                    "(DIR/fit) into DIR (docs/fitter.md, The demo).")
+    demo.add_argument("-o", "--output", type=Path, default=Path("out/demo"), metavar="DIR",
+                      help="output folder (default out/demo; the demo's earlier files there "
+                           "are replaced)")
+    demo.add_argument("--seed", type=int, default=0,
+                      help="which body, camera place and board poses are drawn (default 0)")
+    demo.add_argument("--generations", type=int, metavar="G",
+                      help="the search's generations (default: fitter run's)")
 
     run = sub.add_parser(
         "run", help="fit the body model to a person's front and side photos: mesh (m), "
@@ -178,16 +188,43 @@ def _cmd_model_info(args) -> None:
 
 
 def _cmd_demo(args) -> None:
-    from bodyfit.fitter.demo import DemoSettings, run_demo
-    from bodyfit.fitter.model_cache import load_model
+    import shlex
 
-    if args.bodies < 1:
-        raise UserError(f"--bodies must be at least 1, got {args.bodies}")
+    from bodyfit.fitter.demo import (DemoSettings, calibrate_scene, measurement_table,
+                                     write_scene)
+    from bodyfit.fitter.model_cache import load_model
+    from bodyfit.fitter.run import run_person
+
+    if args.generations is not None and args.generations < 1:
+        raise UserError(f"--generations must be at least 1, got {args.generations}")
     model = load_model()
-    written = run_demo(model, args.output, DemoSettings(bodies=args.bodies, seed=args.seed))
-    print(f"drew {args.bodies} bodies from the body model; wrote:")
-    for path in written:
+    scene = write_scene(model, args.output, DemoSettings(seed=args.seed))
+    calibration, camera_path, coverage_path = calibrate_scene(scene)
+    fx_true, fx = scene.camera.K[0, 0], calibration.camera.K[0, 0]
+    print(f"calibrated the phone camera from {len(scene.board_photos)} board photos "
+          f"({len(calibration.used_views)} used): fx {fx:.1f} px (true {fx_true:.1f}), "
+          f"k1 {calibration.camera.dist[0]:+.3f} (true {scene.camera.dist[0]:+.3f}), "
+          f"RMS {calibration.rms_px:.3f} px")
+    # the fit is `fitter run` on the demo's files, with its defaults and its settings logic
+    run_argv = ["run", "--front", str(scene.front), "--side", str(scene.side),
+                "--height-cm", f"{scene.truth['O'] / 10:.1f}", "--camera", str(camera_path),
+                "-o", str(args.output / "fit"), "--overwrite"]
+    if args.generations is not None:
+        run_argv += ["--generations", str(args.generations)]
+    run_args = _build_parser().parse_args(run_argv)
+    inputs, settings, output = _run_settings(run_args)
+    fit, written = run_person(model, inputs, settings, output, run_args.overwrite,
+                              progress=None if not args.quiet else False)
+    result = fit.search
+    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {result.evaluations} candidates, "
+          f"{result.generations} generations ({settings.search.optimizer}, "
+          f"{settings.projection})")
+    print("\n".join(measurement_table(fit.measurements, scene.truth)))
+    print("wrote:")
+    for path in (scene.front, scene.side, scene.board_photos[0].parent, camera_path,
+                 coverage_path, scene.truth_file, *written):
         print(f"  {path}")
+    print(f"fit the photos again by hand: fitter {shlex.join(run_argv)}")
 
 
 #: `fitter run`'s options that are fields of PersonInputs, and of SearchSettings.

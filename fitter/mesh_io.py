@@ -67,7 +67,7 @@ def read_mesh(path: Path, faces: np.ndarray, units: str = "m") -> np.ndarray:
             f"{path} is a mesh of another topology ({len(mesh.vertices)} vertices, "
             f"{len(mesh.faces)} faces); bodyfit measures meshes in its body model's "
             f"topology ({faces.max() + 1} vertices, {len(faces)} faces), such as the "
-            "body_<i>.obj files that `fitter demo` writes")
+            "mesh.obj files that `fitter run` writes")
     if not np.isfinite(mesh.vertices).all():
         raise UserError(f"{path} holds vertex coordinates that are not finite numbers (NaN or infinity)")
     vertices = mesh.vertices * UNITS_TO_METRES[units]

@@ -15,8 +15,7 @@ import numpy as np
 from bodyfit.fitter.body_model import PART_NAMES
 
 __all__ = ["PART_COLOURS_BGR", "render_parts", "orthographic_pixels", "render_pinhole",
-           "pinhole_pixels",
-           "coverage_mask", "parts_legend", "labelled_grid"]
+           "pinhole_pixels", "coverage_mask", "parts_legend"]
 
 #: One BGR colour per part, ``PART_NAMES`` order.
 PART_COLOURS_BGR = np.array([
@@ -139,42 +138,3 @@ def parts_legend(height_px: int) -> np.ndarray:
         cv2.putText(legend, name, (34, y + 2), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 1,
                     cv2.LINE_AA)
     return legend
-
-
-_LABEL_BAND_PX = 28
-
-
-def labelled_grid(tiles: list[np.ndarray], labels: list[str],
-                  legend: np.ndarray | None = None) -> np.ndarray:
-    """Lay pictures out in a near-square grid, each under its label, on white.
-
-    Args:
-        tiles: (H_i, W_i, 3) uint8 BGR pictures; each is centred in a cell as large as
-            the largest tile.
-        labels: one text per tile (e.g. its file name), written above it.
-        legend: optional (H, W, 3) uint8 BGR picture put to the right of the grid, at the top.
-
-    Returns:
-        (H, W, 3) uint8 BGR picture: rows of at most ceil(sqrt(len(tiles))) cells.
-    """
-    if len(tiles) != len(labels) or not tiles:
-        raise ValueError("labelled_grid needs one label per tile and at least one tile")
-    cell_h = max(t.shape[0] for t in tiles) + _LABEL_BAND_PX
-    cell_w = max(max(t.shape[1] for t in tiles),
-                 max(cv2.getTextSize(text, cv2.FONT_HERSHEY_SIMPLEX, 0.6, 1)[0][0]
-                     for text in labels) + 10)
-    columns = int(np.ceil(np.sqrt(len(tiles))))
-    rows = int(np.ceil(len(tiles) / columns))
-    legend_w = 0 if legend is None else legend.shape[1]
-    height = max(rows * cell_h, 0 if legend is None else legend.shape[0])
-    grid = np.full((height, columns * cell_w + legend_w, 3), 255, np.uint8)
-    for i, (tile, text) in enumerate(zip(tiles, labels)):
-        top, left = (i // columns) * cell_h, (i % columns) * cell_w
-        cv2.putText(grid, text, (left + 8, top + 20), cv2.FONT_HERSHEY_SIMPLEX, 0.6,
-                    (0, 0, 0), 1, cv2.LINE_AA)
-        y = top + _LABEL_BAND_PX
-        x = left + (cell_w - tile.shape[1]) // 2
-        grid[y:y + tile.shape[0], x:x + tile.shape[1]] = tile
-    if legend is not None:
-        grid[:legend.shape[0], columns * cell_w:] = legend
-    return grid

@@ -18,7 +18,8 @@ at the person's left sees it), with ``side_arms``:
 
 Two cameras: the paper's orthographic projection (:func:`photo`, :func:`write_subject`):
 the body is scaled to ``body_px`` pixels tall; or a pinhole camera with a given K at a
-given distance and height, its axis horizontal (:func:`pinhole_photo`,
+given distance and height, its axis horizontal (:func:`pinhole_photo`;
+:func:`write_pinhole_photos`, through a lens's distortion too, as a phone records them;
 :func:`write_pinhole_subject`, which also writes the camera as camera.json).
 """
 
@@ -31,6 +32,7 @@ import cv2
 import numpy as np
 
 from bodyfit.calib.camera import Camera, camera_fields
+from bodyfit.calib.synthetic import distort_image
 
 from bodyfit.fitter.body_model import PART_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import Measurer
@@ -88,7 +90,8 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
     return canvas
 
 
-__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "write_subject", "write_pinhole_subject"]
+__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "write_subject", "write_pinhole_photos",
+           "write_pinhole_subject"]
 
 
 SIDE_ARMS = ("down", "hidden")
@@ -123,20 +126,38 @@ def _side_body(model, betas: np.ndarray, pose_deg: np.ndarray, side_arms: str):
     return forward(model, betas, pose_deg)[0], SIDE_PARTS
 
 
-def write_pinhole_subject(folder, model, betas, pose_deg, intrinsics: np.ndarray,
-                          size_px: tuple[int, int], distance_m: float,
-                          camera_height_m: float, side_arms: str = "down") -> dict[str, float]:
-    """Write front.png, side.png (:func:`pinhole_photo`, both views from the same distance
-    and height; the side photo's arms as ``side_arms``) and camera.json (``intrinsics``, no
-    distortion) into ``folder``; return the true measurements (key -> mm) of the rest body."""
+def write_pinhole_photos(folder, model, betas, pose_deg, camera: Camera, distance_m: float,
+                         camera_height_m: float, side_arms: str = "down") -> dict[str, float]:
+    """Write front.png and side.png through ``camera`` into ``folder``; return the true
+    measurements (key -> mm) of the rest body.
+
+    Each view is :func:`pinhole_photo` through ``camera.K`` at ``camera.image_size_px``
+    (both from the same distance and height; the side photo's arms as ``side_arms``), then
+    recorded through the lens's distortion ``camera.dist``
+    (:func:`bodyfit.calib.synthetic.distort_image`; the backdrop fills where the lens sees
+    beyond the pinhole picture), as the camera's sensor records it.
+    """
     folder = Path(folder)
     betas, pose_deg = np.atleast_2d(betas), np.atleast_2d(pose_deg)
     views = {"front": (forward(model, betas, pose_deg)[0], PART_NAMES),
              "side": _side_body(model, betas, pose_deg, side_arms)}
     for view, (posed, parts) in views.items():
-        cv2.imwrite(str(folder / f"{view}.png"),
-                    pinhole_photo(posed.astype(np.float64), model, view, parts, intrinsics,
-                                  size_px, distance_m, camera_height_m))
-    camera = Camera(tuple(size_px), np.asarray(intrinsics, float), np.zeros(5))
-    (folder / "camera.json").write_text(json.dumps(camera_fields(camera), indent=2))
+        image = pinhole_photo(posed.astype(np.float64), model, view, parts, camera.K,
+                              camera.image_size_px, distance_m, camera_height_m)
+        if np.any(camera.dist):
+            image = distort_image(image, camera.K, camera.dist, BACKDROP_BGR)
+        cv2.imwrite(str(folder / f"{view}.png"), image)
     return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])
+
+
+def write_pinhole_subject(folder, model, betas, pose_deg, intrinsics: np.ndarray,
+                          size_px: tuple[int, int], distance_m: float,
+                          camera_height_m: float, side_arms: str = "down") -> dict[str, float]:
+    """Write front.png, side.png (:func:`write_pinhole_photos` through ``intrinsics``, no
+    distortion) and that camera as camera.json into ``folder``; return the true
+    measurements (key -> mm) of the rest body."""
+    camera = Camera(tuple(size_px), np.asarray(intrinsics, float), np.zeros(5))
+    truth = write_pinhole_photos(folder, model, betas, pose_deg, camera, distance_m,
+                                 camera_height_m, side_arms)
+    (Path(folder) / "camera.json").write_text(json.dumps(camera_fields(camera), indent=2))
+    return truth

@@ -23,21 +23,64 @@ def no_user_model(tmp_path_factory, monkeypatch):
     monkeypatch.setenv(model_cache.CACHE_ENV_VAR, str(tmp_path_factory.mktemp("cache")))
 
 
-def test_demo_writes_meshes_measurements_and_picture(body_model, tmp_path, capsys):
-    out_dir = tmp_path / "demo"
-    code, out, err = run(capsys, "-q", "demo", "-o", str(out_dir), "--bodies", "4")
+def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measurer, tmp_path,
+                                                             capsys, monkeypatch):
+    import re
+    import shlex
+
+    from bodyfit.fitter.body_model import rest_shape
+    from bodyfit.fitter.demo import DemoSettings, demo_camera
+    from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
+    from bodyfit.fitter.run import RUN_FILES
+
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(capsys, "-q", "demo", "-o", "demo", "--generations", "3")
     assert code == 0, err
-    names = sorted(p.name for p in out_dir.iterdir())
-    assert names == ["bodies.png"] + [f"body_{i}.{s}" for i in range(4) for s in ("obj", "ply")] \
-        + ["measurements.csv", "measurements.json"]
-    table = json.loads((out_dir / "measurements.json").read_text())
-    assert table["units"] == "mm" and set(table["bodies"]) == {f"body_{i}" for i in range(4)}
-    assert len((out_dir / "measurements.csv").read_text().splitlines()) == 1 + 4 * 16
+    out_dir = tmp_path / "demo"
+    assert sorted(p.name for p in out_dir.iterdir()) == [
+        "board", "camera.json", "camera_coverage.png", "fit", "front.png", "side.png",
+        "truth.json"]
+    assert len(list((out_dir / "board").glob("*.png"))) == 12 + 2
+    assert sorted(p.name for p in (out_dir / "fit").iterdir()) == sorted(RUN_FILES)
+    # the calibration recovered the synthetic phone camera
+    true_camera = demo_camera(DemoSettings().size_px)
+    camera = json.loads((out_dir / "camera.json").read_text())
+    assert camera["K"][0][0] == pytest.approx(true_camera.K[0, 0], rel=0.01)
+    assert camera["provenance"]["argv"][:2] == ["calib", "capture"]
+    # truth.json holds the true camera and the measurements of the body it records
+    truth_record = json.loads((out_dir / "truth.json").read_text())
+    np.testing.assert_allclose(truth_record["camera"]["K"], true_camera.K)
+    betas = np.array(truth_record["body"]["betas_sigma"])
+    expected = measurer.measure(rest_shape(body_model, betas[None])[0][0])
+    truth = {row["letter"]: row["value_mm"] for row in truth_record["measurements"].values()}
+    for key in MEASUREMENTS:
+        assert truth[key] == pytest.approx(expected[key], abs=0.01)
+    # the fit went through `fitter run --camera` with its default settings, 3 generations
+    record = json.loads((out_dir / "fit" / "run.json").read_text())
+    assert record["settings"]["projection"] == "pinhole"
+    assert record["settings"]["search"]["generations"] == 3
+    assert record["inputs"]["camera"] == "demo/camera.json"
+    fitted = {row["letter"]: row["value_mm"] for row in json.loads(
+        (out_dir / "fit" / "measurements.json").read_text())["measurements"].values()}
+    assert abs(fitted["O"] - truth["O"]) < 15.0
+    # the printed table: 16 rows of fitted, true and error, then the important ones' mean
+    rows = re.findall(r"^  ([A-P]) .+? +(-?\d+\.\d) +(-?\d+\.\d) +([+-]\d+\.\d)$", out,
+                      re.MULTILINE)
+    assert [key for key, *_ in rows] == list(MEASUREMENTS)
+    for key, value, true, error in rows:
+        assert float(value) == pytest.approx(fitted[key], abs=0.06)
+        assert float(true) == pytest.approx(truth[key], abs=0.06)
+        assert float(error) == pytest.approx(fitted[key] - truth[key], abs=0.11)
+    mae = float(re.search(r"7 important .*: (\d+\.\d) mm", out).group(1))
+    assert mae == pytest.approx(np.mean([abs(fitted[k] - truth[k]) for k in IMPORTANT]),
+                                abs=0.06)
+    # the printed command fits the photos again by hand: the same body
+    command = re.search(r"by hand: fitter (.+)$", out, re.MULTILINE).group(1)
+    code, _, err = run(capsys, "-q", *shlex.split(command))
+    assert code == 0, err
+    again = json.loads((out_dir / "fit" / "measurements.json").read_text())["measurements"]
+    assert {row["letter"]: row["value_mm"] for row in again.values()} == fitted
     assert not list(tmp_path.glob(".*partial*"))
-    import cv2
-    picture = cv2.imread(str(out_dir / "bodies.png"))
-    assert picture.shape[0] > 2 * 500  # 4 bodies of 500 px in a 2 x 2 grid, not a strip
-    assert picture.shape[1] < 1.5 * picture.shape[0]  # a strip would be 4.7 times wider
 
 
 def test_version_and_usage_errors(capsys):
@@ -107,7 +150,8 @@ def test_measure_other_topology_exit_2(body_model, tmp_path, capsys):
 @pytest.mark.parametrize("argv,message", [
     (["model", "build", "--samples", "7"], "--samples"),
     (["model", "build", "--components", "0"], "--components"),
-    (["demo", "--bodies", "0"], "--bodies"),
+    (["demo", "--generations", "0"], "--generations"),
+    (["demo", "-o", __file__], "is a file"),
     (["model", "build", "-o", "model.txt"], "-o takes a .npz"),
 ])
 def test_bad_options_are_one_line_exit_2(capsys, argv, message):

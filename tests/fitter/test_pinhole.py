@@ -7,6 +7,7 @@ import cv2
 import numpy as np
 import pytest
 
+from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import to_upright
 from bodyfit.fitter.body_model import PART_NAMES, forward
@@ -15,7 +16,9 @@ from bodyfit.fitter.cli import main
 from bodyfit.fitter.pinhole_canvas import (Placement, phone_intrinsics, pinhole_view,
                                            solve_placement, upright_intrinsics)
 from bodyfit.fitter.run import RUN_FILES
-from bodyfit.fitter.studio_photos import BACKDROP_BGR, pinhole_photo, write_pinhole_subject
+from bodyfit.calib.silhouette import photo_silhouette
+from bodyfit.fitter.studio_photos import (BACKDROP_BGR, pinhole_photo, write_pinhole_photos,
+                                          write_pinhole_subject)
 from bodyfit.kernels.view_camera import camera_matrices
 
 SIZE_PX = (750, 1000)
@@ -108,6 +111,30 @@ def test_solved_distance_of_another_body(body_model, mean_body, tmp_path, distan
         placement = solve_placement(view, mask, K_TRUE, body[shown])
         assert placement.distance_m == pytest.approx(distance_m, rel=0.02), view
         assert placement.height_m == pytest.approx(height_m, abs=0.05), view
+
+
+def test_photos_through_a_distorting_lens_undistort_to_the_pinhole_photos(body_model,
+                                                                           tmp_path):
+    """A phone lens's distortion moves the outline by pixels; calib's silhouette,
+    undistorted with the lens, gives back the pinhole photo's to within a pixel."""
+    pinhole, lens = tmp_path / "pinhole", tmp_path / "lens"
+    pinhole.mkdir(), lens.mkdir()
+    camera = Camera(SIZE_PX, K_TRUE, np.array([-0.11, 0.21, 0.0, 0.0, 0.0]))
+    for folder, dist in ((pinhole, np.zeros(5)), (lens, camera.dist)):
+        write_pinhole_photos(folder, body_model, SUBJECT_BETAS, SUBJECT_POSE,
+                             Camera(SIZE_PX, K_TRUE, dist), 2.5, 1.0)
+    for view in ("front", "side"):
+        ideal = person_mask(cv2.imread(str(pinhole / f"{view}.png")))
+        recorded = cv2.imread(str(lens / f"{view}.png"))
+        # the lens sees beyond the pinhole picture's corners: backdrop there, not black
+        assert (recorded[0, 0] == BACKDROP_BGR).all() and (recorded[-1, -1] == BACKDROP_BGR).all()
+        as_recorded = person_mask(recorded)
+        undistorted = photo_silhouette(lens / f"{view}.png", camera)
+        rows = [np.flatnonzero(mask.any(axis=1)) for mask in (ideal, as_recorded, undistorted)]
+        heights = [r[-1] - r[0] + 1 for r in rows]
+        assert heights[0] - heights[1] >= 4, view  # the barrel lens shrank the person
+        assert abs(heights[2] - heights[0]) <= 1 and abs(rows[2][0] - rows[0][0]) <= 1, view
+        assert (undistorted ^ ideal).sum() < (as_recorded ^ ideal).sum() / 8, view
 
 
 def test_run_with_camera_writes_its_outputs(body_model, tmp_path, capsys):
