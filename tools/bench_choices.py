@@ -22,6 +22,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import warp
 
 from bodyfit import kernels
 from bodyfit.fitter.fit import FitSettings, fit_person
@@ -62,6 +63,7 @@ def _true_cost(model, fit, settings: FitSettings, betas, pose, stature_m) -> flo
 
 
 def main() -> None:
+    warp.config.quiet = True  # no initialisation banner in the Markdown
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--subjects", type=int, default=4)
     parser.add_argument("--seed", type=int, default=7)

@@ -30,6 +30,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import warp
 
 from bodyfit.fitter.fit import FitSettings, fit_person
 from bodyfit.fitter.measurements import IMPORTANT
@@ -49,6 +50,7 @@ KEYS = ("D", "E", "F")
 
 
 def main() -> None:
+    warp.config.quiet = True  # no initialisation banner in the Markdown
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--subjects", type=int, default=4)
     parser.add_argument("--seed", type=int, default=7, help="subjects' seed")
