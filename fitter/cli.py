@@ -17,9 +17,6 @@ from bodyfit.calib.errors import UserError
 
 __all__ = ["main"]
 
-#: The projection without --camera (docs/fitter.md, Cameras: chosen by the benchmark).
-NO_CAMERA_PROJECTION = "orthographic"
-
 logger = logging.getLogger("bodyfit")
 
 
@@ -95,7 +92,7 @@ def _build_parser() -> argparse.ArgumentParser:
                      help="pinhole: the camera of --camera, or without it a typical phone "
                           "camera (70 degrees across the long side); "
                           "orthographic: the paper's, each view scaled from the stature "
-                          f"(default: pinhole with --camera, else {NO_CAMERA_PROJECTION})")
+                          "(default pinhole; --method paper: orthographic)")
     run.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
                      "(white person on black, of the undistorted upright photo)")
     run.add_argument("--mask-side", metavar="PNG", help="your own side silhouette")
@@ -278,9 +275,7 @@ def _run_settings(args):
     settings = dataclasses.replace(settings, search=search, cost=cost,
                                    device=given.get("device", settings.device),
                                    side_arms=given.get("side_arms", settings.side_arms),
-                                   projection=given.get("projection") or (
-                                       settings.projection if args.config else "pinhole"
-                                       if inputs.camera else NO_CAMERA_PROJECTION))
+                                   projection=given.get("projection", settings.projection))
     return inputs, settings, output
 
 

@@ -43,8 +43,9 @@ class FitSettings:
         side_arms: how the side view treats the person's arms, one of
             ``bodyfit.fitter.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
             arms hanging down; "hidden": without arms).
-        projection: "orthographic" (the paper's, each view scaled from the stature) or
-            "pinhole" (the photos' camera, :mod:`bodyfit.fitter.pinhole_canvas`).
+        projection: "pinhole" (the photos' camera, or a typical phone's without one,
+            :mod:`bodyfit.fitter.pinhole_canvas`; the default) or "orthographic" (the
+            paper's, each view scaled from the stature).
     """
 
     search: SearchSettings = SearchSettings()
@@ -53,7 +54,7 @@ class FitSettings:
         matching="symmetric", vertical_anchor="extremes", top_weight=0.0, bottom_weight=0.0)
     device: str = "cpu"
     side_arms: str = "down"
-    projection: str = "orthographic"
+    projection: str = "pinhole"
 
 
 #: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
@@ -64,7 +65,7 @@ METHODS = {
     "bodyfit": FitSettings(),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False),
-                         cost=kernels.CostSettings()),
+                         cost=kernels.CostSettings(), projection="orthographic"),
 }
 #: The weights preset (:data:`bodyfit.fitter.weights.PRESETS`) of each method's cost.
 METHOD_WEIGHTS = {"bodyfit": "bodyfit", "paper": "paper"}

@@ -71,8 +71,8 @@ def main() -> None:
     args = parser.parse_args()
     model = load_model()
     base = FitSettings()
-    base = dataclasses.replace(base, search=dataclasses.replace(
-        base.search, generations=args.generations))
+    base = dataclasses.replace(base, projection="orthographic", search=dataclasses.replace(
+        base.search, generations=args.generations))  # the studio photos are orthographic
     variants = _variants(base)
     rng = np.random.default_rng(args.seed)
     rows = {name: {"err": [], "spread": [], "found": [], "true": [], "s": []}

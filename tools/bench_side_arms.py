@@ -75,7 +75,8 @@ def main() -> None:
                                       truth["O"] / 10)
                 start = time.perf_counter()
                 fit = fit_person(model, person_masks(inputs), truth["O"] / 1000,
-                                 FitSettings(search=search, side_arms=fit_arms), progress=False)
+                                 FitSettings(search=search, side_arms=fit_arms,
+                                             projection="orthographic"), progress=False)
                 seconds[name].append(time.perf_counter() - start)
                 errors[name].append({k: fit.measurements[k] - truth[k] for k in truth})
     print(f"`python tools/bench_side_arms.py --subjects {args.subjects} --seed {args.seed} "

@@ -25,7 +25,7 @@ from bodyfit.kernels import CostSettings
 BETAS = np.r_[0.5, np.zeros(19)]
 POSE = np.array([5.0, 5.0, 3.0, 3.0])
 BUDGET = ["--optimizer", "ga", "--population", "10", "--generations", "2", "--seed", "5",
-          "--weight", "waist=7"]
+          "--weight", "waist=7", "--projection", "orthographic"]  # orthographic studio photos
 
 
 class _Page(html.parser.HTMLParser):
@@ -97,6 +97,7 @@ def test_run_json_round_trips_into_the_same_settings(first_run):
     config = read_run_config(first_run / "run.json")
     assert config.settings == FitSettings(
         search=SearchSettings(optimizer="ga", population=10, generations=2, seed=5),
+        projection="orthographic",
         cost=dataclasses.replace(FitSettings().cost,
                                  part_weights=(2.0, 5.0, 7.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0)))
     assert config.inputs.front.endswith("front.png") and config.output == first_run

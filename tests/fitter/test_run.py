@@ -29,8 +29,9 @@ def run(capsys, *argv):
 
 
 def person_args(folder, truth):
+    """The subject's options; its studio photos are orthographic."""
     return ["--front", str(folder / "front.png"), "--side", str(folder / "side.png"),
-            "--height-cm", f"{truth['O'] / 10:.2f}"]
+            "--height-cm", f"{truth['O'] / 10:.2f}", "--projection", "orthographic"]
 
 
 def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, capsys):

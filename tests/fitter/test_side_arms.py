@@ -83,7 +83,8 @@ def test_a_side_photo_with_the_arms_down_costs_the_true_body_little_only_with_ar
     side_cost = {}
     for arms in ("down", "hidden"):
         fit = fit_person(body_model, masks, truth["O"] / 1000,
-                         FitSettings(search=search, side_arms=arms), progress=False)
+                         FitSettings(search=search, side_arms=arms,
+                                             projection="orthographic"), progress=False)
         arrays = kernels.ModelArrays.from_body_model(body_model, 20)
         evaluator = kernels.PopulationEvaluator(arrays, [fit.views["side"]])
         part_costs = evaluator.evaluate(BETAS[None], POSE[None]).part_costs[0]
