@@ -56,6 +56,20 @@ def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, cap
     assert cv2.imread(str(out / "convergence.png")).shape == (480, 800, 3)
 
 
+def test_default_fit_measures_the_subject(subject, tmp_path, capsys):
+    """The default search end to end (about 30 s): stature within 5 mm, chest, waist and
+    hip within 15 mm of the truth (here about 2, 4 and 5 mm)."""
+    folder, truth = subject
+    out = tmp_path / "out"
+    code, _, err = run(capsys, "run", *person_args(folder, truth), "-o", str(out))
+    assert code == 0, err
+    table = json.loads((out / "measurements.json").read_text())["measurements"]
+    fitted = {row["letter"]: row["value_mm"] for row in table.values()}
+    assert abs(fitted["O"] - truth["O"]) < 5.0
+    for key in ("D", "E", "F"):
+        assert abs(fitted[key] - truth[key]) < 15.0, (key, fitted[key], truth[key])
+
+
 def test_same_seed_same_result(subject, tmp_path, capsys):
     folder, truth = subject
     budget = ["--optimizer", "ga", "--population", "12", "--generations", "3", "--seed", "4"]
