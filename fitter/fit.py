@@ -82,6 +82,9 @@ class Fit:
         spreads: key -> mm, the spread described in the module docstring.
         views: the kernels' targets (canvas silhouettes and cameras), by view name.
         seconds: stage -> wall seconds ("canvas", "search", "measure").
+        view_bodies: view name -> (V, 3) float32 metres, the best candidate as the search
+            scored it in that view (its pose with the view's fixed angles, e.g. the side
+            view's arms down; not rescaled to the stature): what the view's canvas shows.
     """
 
     search: SearchResult
@@ -91,6 +94,7 @@ class Fit:
     spreads: dict[str, float]
     views: dict[str, kernels.ViewTarget]
     seconds: dict[str, float]
+    view_bodies: dict[str, np.ndarray]
 
 
 def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult,
@@ -164,6 +168,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     t2 = time.perf_counter()
     betas = result.betas[None]
     posed = forward(model, betas, result.pose_deg[None])[0]
+    view_bodies = {name: forward(model, betas, view.view_pose(result.pose_deg[None]))[0]
+                   for name, view in views.items()}
     rest = rest_shape(model, betas)[0][0]
     if s.condition_stature:  # the fit stands as tall as the person's stature: rescale it
         scale = stature_scale(rest, stature_m)
@@ -173,4 +179,4 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     spreads = _spreads(model, measurer, result, stature_m if s.condition_stature else None)
     t3 = time.perf_counter()
     return Fit(result, posed, rest, measurements, spreads, views,
-               {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2})
+               {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies)

@@ -92,7 +92,8 @@ def match_contours(model: BodyModel, posed: np.ndarray, view: kernels.ViewTarget
 
     Args:
         model: the body model (faces and their parts).
-        posed: (V, 3) float metres, the fitted body in its fitted pose.
+        posed: (V, 3) float metres, the fitted body as the view's canvas shows it
+            (``Fit.view_bodies``).
         view: the view's kernel target (camera, canvas size, person's mask, visible parts).
         device: where the kernels run.
     """

@@ -120,7 +120,7 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
         write_json(stage / "run.json", record)
         pictures = {"convergence": chart}
         for name, view in fit.views.items():
-            matched = match_contours(model, fit.posed, view, settings.device)
+            matched = match_contours(model, fit.view_bodies[name], view, settings.device)
             pictures[f"overlay_{name}"] = overlay_image(matched)
             pictures[f"outline_{name}"] = fitted_outline_image(matched)
             write_image(stage / f"overlay_{name}.png", pictures[f"overlay_{name}"])
