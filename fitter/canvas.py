@@ -33,7 +33,7 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel, forward
 from bodyfit.kernels.view_camera import camera_matrices
 
-__all__ = ["CanvasSettings", "model_extent", "orthographic_view", "scaled_person"]
+__all__ = ["CanvasSettings", "extreme_bodies", "orthographic_view", "scaled_person"]
 
 #: The parts each view renders: the side photo is taken with the arms hanging against
 #: the body, which the model's four pose angles cannot reproduce (kernels.SIDE_VIEW_PARTS).
@@ -61,21 +61,20 @@ class CanvasSettings:
             raise UserError(f"the canvas body height must be 32-2048 px, got {self.body_height_px}")
 
 
-def model_extent(model: BodyModel, num_betas: int, pose_lower, pose_upper,
-                 beta_limit: float = 3.0) -> np.ndarray:
-    """(M, 3) float32 vertices, metres, that bound every candidate the search may ask for.
-
-    The mean body and, for each of the first ``num_betas`` components at +-``beta_limit``
-    sigma, the body with every pose angle at its lower and at its upper bound; the union of
-    their vertices (a candidate's silhouette lies within their extent up to the
-    interactions of several components, which the canvas margin absorbs).
+def extreme_bodies(model: BodyModel, num_betas: int, pose_lower, pose_upper,
+                   beta_limit: float = 3.0) -> np.ndarray:
+    """(B, V, 3) float32 posed bodies, metres, that bound every candidate the search may
+    ask for: the mean body and, for each of the first ``num_betas`` components at
+    +-``beta_limit`` sigma, the body with every pose angle at its lower and at its upper
+    bound (B = 2 (2 K + 1)). A candidate's silhouette lies within the extent of their
+    vertices up to the interactions of several components, which the canvas margin
+    absorbs; the stature conditioning takes its highest and lowest vertices from them.
     """
     k = num_betas
     betas = np.concatenate([np.zeros((1, k)), beta_limit * np.eye(k), -beta_limit * np.eye(k)])
     poses = [np.broadcast_to(np.asarray(p, np.float64), (len(betas), 4))
              for p in (pose_lower, pose_upper)]
-    vertices = [forward(model, betas, pose) for pose in poses]
-    return np.concatenate([v.reshape(-1, 3) for v in vertices]).astype(np.float32)
+    return np.concatenate([forward(model, betas, pose) for pose in poses]).astype(np.float32)
 
 
 def _project(camera, points: np.ndarray) -> np.ndarray:
@@ -103,7 +102,7 @@ def orthographic_view(name: str, mask: np.ndarray, stature_m: float, extent: np.
         name: ``"front"`` or ``"side"``.
         mask: (H, W) bool, the person's silhouette in the (undistorted, upright) photo.
         stature_m: the person's stature, metres.
-        extent: (M, 3) float32 metres, from :func:`model_extent`.
+        extent: (M, 3) float32 metres, the vertices of :func:`extreme_bodies`.
         mean_body: (V, 3) float32 metres, the mean body in its default pose.
         settings: canvas geometry.
         device: where the kernels run.

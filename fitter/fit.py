@@ -17,7 +17,7 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
-from bodyfit.fitter.canvas import CanvasSettings, model_extent, orthographic_view
+from bodyfit.fitter.canvas import CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
@@ -148,8 +148,9 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     s.validate(model.num_components)
     settings.canvas.validate()
     t0 = time.perf_counter()
-    extent = model_extent(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
-                          settings.canvas.beta_limit)
+    bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
+                            settings.canvas.beta_limit)
+    extent = bodies.reshape(-1, 3)
     mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
     # arms turned down in the frontal plane keep their side-view width and stay above
     # the feet, so the extent of the search's pose range covers them
@@ -161,8 +162,7 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)
     conditioner = None
     if s.condition_stature:
-        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit,
-                                         s.pose_lower_deg, s.pose_upper_deg)
+        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies)
     t1 = time.perf_counter()
     result = search(evaluator, s, conditioner, progress)
     t2 = time.perf_counter()

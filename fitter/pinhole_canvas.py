@@ -208,7 +208,8 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
         intrinsics: (3, 3) K of that photo (:func:`upright_intrinsics` of camera.json's, or
             :func:`phone_intrinsics`), pixels.
         stature_m: the person's stature, metres.
-        extent: (M, 3) float32 metres, from :func:`bodyfit.fitter.canvas.model_extent`.
+        extent: (M, 3) float32 metres, the vertices of
+            :func:`bodyfit.fitter.canvas.extreme_bodies`.
         mean_body: (V, 3) float32 metres, the mean body in its default pose.
         vertex_parts: (V,) int, each vertex's index in ``PART_NAMES``: the placement is
             solved with the parts the view shows (no arms in the side view).

@@ -137,38 +137,35 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
         if not settings.condition_stature:
             return genes[:, :k]
         return conditioner.complete(genes[:, :k], genes[:, k:])
+
     budget = {} if settings.generations is None else {"generations": settings.generations}
     optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
                                population=settings.population, seed=settings.seed, **budget)
     start = time.perf_counter()
     best_costs, mean_costs = [], []
-    best = (np.inf, None, None)
-    evaluations = 0
     with tqdm(desc=f"search ({settings.optimizer})", unit="gen", dynamic_ncols=True,
               disable=None if progress is None else not progress) as bar:
         while not optimizer.stop():
             genes = optimizer.ask()
-            betas = betas_of(genes)
-            scored = evaluator.evaluate(betas, genes[:, k:])
-            costs = scored.costs.astype(np.float64)
+            costs = evaluator.evaluate(betas_of(genes), genes[:, k:]).costs.astype(np.float64)
             optimizer.tell(genes, costs)
-            evaluations += len(genes)
-            i = int(np.argmin(costs))
-            if costs[i] < best[0]:
-                best = (float(costs[i]), np.r_[betas[i], genes[i, k:]],
-                        scored.part_costs[i].copy())
             finite = costs[np.isfinite(costs)]
-            best_costs.append(best[0])
+            best_costs.append(optimizer.result.best_cost)
             mean_costs.append(float(finite.mean()) if finite.size else np.inf)
             bar.update(1)
-            bar.set_postfix(best=f"{best[0]:.1f}")
-            last_genes, last_costs = np.concatenate([betas, genes[:, k:]], axis=1), costs
-    if best[1] is None:
+            bar.set_postfix(best=f"{best_costs[-1]:.1f}")
+    result = optimizer.result
+    if not np.isfinite(result.best_cost):
         raise UserError("no candidate body produced a silhouette; check the photos and masks")
-    full = settings.components
+    best = result.best_candidate[None]
+    best_betas = betas_of(best)
+    scored = evaluator.evaluate(best_betas, best[:, k:])  # its per-term breakdown
     return SearchResult(
-        betas=best[1][:full], pose_deg=best[1][full:], cost=best[0], part_costs=best[2],
-        best_costs=np.array(best_costs), mean_costs=np.array(mean_costs),
-        final_genes=last_genes, final_costs=last_costs, evaluations=evaluations,
-        generations=len(best_costs), seconds=time.perf_counter() - start,
-        stop_reasons=dict(optimizer.stop()))
+        betas=best_betas[0], pose_deg=best[0, k:], cost=result.best_cost,
+        part_costs=scored.part_costs[0], best_costs=np.array(best_costs),
+        mean_costs=np.array(mean_costs),
+        final_genes=np.concatenate([betas_of(result.population), result.population[:, k:]],
+                                   axis=1),
+        final_costs=result.population_costs, evaluations=result.evaluations,
+        generations=result.generations, seconds=time.perf_counter() - start,
+        stop_reasons=result.stop_reasons)

@@ -25,7 +25,7 @@ import dataclasses
 
 import numpy as np
 
-from bodyfit.fitter.body_model import BodyModel, abduction_rotations, forward
+from bodyfit.fitter.body_model import BodyModel, abduction_rotations
 
 __all__ = ["StatureConditioner", "stature_scale"]
 
@@ -44,27 +44,26 @@ class StatureConditioner:
         height_m: the posed height every candidate must have, metres.
         beta_limit: the solved beta is kept within +-this (a body that cannot reach the
             height inside it keeps the limit, and its silhouette's height then differs).
-        pose_lower, pose_upper: (4,) degrees, the pose range the extreme vertices must cover.
+        bodies: (B, V, 3) metres, bodies spanning the search's shapes and poses
+            (:func:`bodyfit.fitter.canvas.extreme_bodies`): the vertices near their highest
+            and lowest points are the only ones a candidate's height is read from.
     """
 
     def __init__(self, model: BodyModel, num_betas: int, height_m: float,
-                 beta_limit: float, pose_lower, pose_upper):
+                 beta_limit: float, bodies: np.ndarray):
         self.num_betas = num_betas
         self.height_m = float(height_m)
         self.beta_limit = float(beta_limit)
-        band = self._extreme_vertices(model, num_betas, beta_limit, pose_lower, pose_upper)
+        band = self._extreme_vertices(np.asarray(bodies)[..., 2])
         self._model = dataclasses.replace(
             model, mean_vertices=model.mean_vertices[band],
             vertex_components=model.vertex_components[:, band],
             chain_weights=model.chain_weights[band], vertex_parts=model.vertex_parts[band])
 
     @staticmethod
-    def _extreme_vertices(model, k, limit, pose_lower, pose_upper) -> np.ndarray:
-        """Indices of the vertices that can be a body's highest or lowest point."""
-        betas = np.concatenate([np.zeros((1, k)), limit * np.eye(k), -limit * np.eye(k)])
-        z = np.concatenate([forward(model, betas, np.broadcast_to(np.asarray(p, float),
-                                                                  (len(betas), 4)))[..., 2]
-                            for p in (pose_lower, pose_upper)])
+    def _extreme_vertices(z: np.ndarray) -> np.ndarray:
+        """Indices of the vertices that can be a body's highest or lowest point, from the
+        (B, V) heights of the extreme bodies."""
         top = z >= z.max(axis=1, keepdims=True) - _EXTREME_BAND_M
         bottom = z <= z.min(axis=1, keepdims=True) + _EXTREME_BAND_M
         return np.flatnonzero((top | bottom).any(axis=0))

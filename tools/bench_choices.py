@@ -25,6 +25,7 @@ import numpy as np
 import warp
 
 from bodyfit import kernels
+from bodyfit.fitter.canvas import extreme_bodies
 from bodyfit.fitter.fit import FitSettings, fit_person
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model_cache import load_model
@@ -54,8 +55,9 @@ def _variants(base: FitSettings) -> dict[str, FitSettings]:
 def _true_cost(model, fit, settings: FitSettings, betas, pose, stature_m) -> float:
     s = settings.search
     if s.condition_stature:
-        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit,
-                                         s.pose_lower_deg, s.pose_upper_deg)
+        bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
+                                s.beta_limit)
+        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies)
         betas = conditioner.complete(betas[None, 1:], pose[None])[0]
     arrays = kernels.ModelArrays.from_body_model(model, s.components)
     evaluator = kernels.PopulationEvaluator(arrays, list(fit.views.values()), settings.cost)

@@ -11,7 +11,7 @@ from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import to_upright
 from bodyfit.fitter.body_model import PART_NAMES, forward
-from bodyfit.fitter.canvas import VIEW_PARTS, model_extent
+from bodyfit.fitter.canvas import VIEW_PARTS, extreme_bodies
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.pinhole_canvas import (Placement, phone_intrinsics, pinhole_view,
                                            solve_placement, upright_intrinsics)
@@ -81,7 +81,7 @@ def test_a_body_point_lands_where_the_photo_has_it(body_model, mean_body):
     for view, parts in VIEW_PARTS.items():
         mask = person_mask(pinhole_photo(body, body_model, view, parts, K_TRUE, SIZE_PX,
                                          truth.distance_m, truth.height_m))
-        extent = model_extent(body_model, 20, [-5.0] * 4, [30.0] * 4)
+        extent = extreme_bodies(body_model, 20, [-5.0] * 4, [30.0] * 4).reshape(-1, 3)
         target = pinhole_view(view, mask, K_TRUE, float(np.ptp(body[:, 2])), extent, mean_body,
                               body_model.vertex_parts)
         k_canvas, r, t = camera_matrices(target.camera)

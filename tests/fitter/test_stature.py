@@ -5,7 +5,13 @@ import pytest
 
 from bodyfit.fitter.body_model import forward, rest_shape
 from bodyfit.fitter.search import SearchSettings
+from bodyfit.fitter.canvas import extreme_bodies
 from bodyfit.fitter.stature import StatureConditioner, stature_scale
+
+
+def range_bodies(model):
+    """The extreme bodies of the default search's range."""
+    return extreme_bodies(model, 20, [-10] * 4, [30] * 4)
 
 
 @pytest.mark.parametrize("height_m", [1.55, 1.75, 1.95])
@@ -13,7 +19,7 @@ def test_solved_first_beta_gives_the_posed_height(body_model, height_m):
     """Checked with the NumPy forward on every vertex (the solver sees only the extremes
     through its linear map)."""
     rng = np.random.default_rng(2)
-    conditioner = StatureConditioner(body_model, 20, height_m, 3.0, [-10] * 4, [30] * 4)
+    conditioner = StatureConditioner(body_model, 20, height_m, 3.0, range_bodies(body_model))
     other, pose = rng.uniform(-1.5, 1.5, (12, 19)), rng.uniform(-10, 30, (12, 4))
     betas = conditioner.complete(other, pose)
     np.testing.assert_array_equal(betas[:, 1:], other)
@@ -26,7 +32,7 @@ def test_solved_first_beta_gives_the_posed_height(body_model, height_m):
 
 
 def test_unreachable_height_keeps_the_beta_limit(body_model):
-    conditioner = StatureConditioner(body_model, 20, 2.6, 3.0, [-10] * 4, [30] * 4)
+    conditioner = StatureConditioner(body_model, 20, 2.6, 3.0, range_bodies(body_model))
     betas = conditioner.complete(np.zeros((1, 19)), np.zeros((1, 4)))
     assert abs(betas[0, 0]) == pytest.approx(3.0)
 
