@@ -235,7 +235,7 @@ def _run_settings(args):
     or with --config the run.json's values, overridden by every option given."""
     import dataclasses
 
-    from bodyfit.fitter.fit import METHOD_WEIGHTS, METHODS
+    from bodyfit.fitter.fit import METHODS
     from bodyfit.fitter.person import PersonInputs
     from bodyfit.fitter.run_config import read_run_config
     from bodyfit.fitter.weights import (cost_settings, parse_override, settings_from_record,
@@ -265,13 +265,11 @@ def _run_settings(args):
     cost = settings.cost
     cost = dataclasses.replace(cost, **{k: given[k] for k in ("matching", "vertical_anchor")
                                         if k in given})
-    if "weights" in given or "weight" in given:
-        if "weights" in given or args.config is None:
-            cost = cost_settings(given.get("weights", METHOD_WEIGHTS[args.method or "bodyfit"]),
-                                 given.get("weight", []), cost)
-        else:  # --weight on top of the recorded weights
-            record = weights_record(cost) | dict(map(parse_override, args.weight))
-            cost = settings_from_record(record, cost)
+    if "weights" in given:
+        cost = cost_settings(given["weights"], given.get("weight", []), cost)
+    elif "weight" in given:  # on top of the method's or the recorded weights
+        record = weights_record(cost) | dict(map(parse_override, args.weight))
+        cost = settings_from_record(record, cost)
     settings = dataclasses.replace(settings, search=search, cost=cost,
                                    device=given.get("device", settings.device),
                                    side_arms=given.get("side_arms", settings.side_arms),
@@ -286,7 +284,6 @@ def _cmd_run(args) -> None:
 
     try:
         inputs, settings, output = _run_settings(args)
-        inputs.validate()
         model = load_model()
         fit, written = run_person(model, inputs, settings, output, args.overwrite,
                                   progress=None if not args.quiet else False)

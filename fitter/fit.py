@@ -23,8 +23,9 @@ from bodyfit.fitter.pinhole_canvas import pinhole_view
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, stature_scale
+from bodyfit.fitter.weights import cost_settings
 
-__all__ = ["FitSettings", "METHODS", "METHOD_WEIGHTS", "Fit", "fit_person"]
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person"]
 
 _SPREAD_SHARE = 0.25
 _SPREAD_MIN = 3
@@ -50,8 +51,8 @@ class FitSettings:
 
     search: SearchSettings = SearchSettings()
     canvas: CanvasSettings = CanvasSettings()
-    cost: kernels.CostSettings = kernels.CostSettings(
-        matching="symmetric", vertical_anchor="extremes", top_weight=0.0, bottom_weight=0.0)
+    cost: kernels.CostSettings = cost_settings(
+        "bodyfit", base=kernels.CostSettings(matching="symmetric", vertical_anchor="extremes"))
     device: str = "cpu"
     side_arms: str = "down"
     projection: str = "pinhole"
@@ -67,8 +68,7 @@ METHODS = {
                                                generations=None, condition_stature=False),
                          cost=kernels.CostSettings(), projection="orthographic"),
 }
-#: The weights preset (:data:`bodyfit.fitter.weights.PRESETS`) of each method's cost.
-METHOD_WEIGHTS = {"bodyfit": "bodyfit", "paper": "paper"}
+
 
 @dataclasses.dataclass(frozen=True)
 class Fit:
