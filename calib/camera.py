@@ -16,7 +16,6 @@ files), so that ``calib check`` can tell held-out photos from calibration photos
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +24,7 @@ import numpy as np
 
 from bodyfit.calib.boards import BoardSpec
 from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import read_json_file
 
 __all__ = ["CAMERA_FORMAT", "DIST_LENGTHS", "CalibrationInput", "Camera", "camera_fields", "load_camera"]
 
@@ -111,23 +111,17 @@ def _is_whole(value: object, lowest: int, highest: int) -> bool:
     return isinstance(value, int) and not isinstance(value, bool) and lowest <= value <= highest
 
 
+_ADVICE = "; run `calib capture` again to make a new one"
+
+
 def _fail(path: Path, problem: str) -> UserError:
-    return UserError(f"camera file {path}: {problem}; run `calib capture` again to make a new one")
+    return UserError(f"camera file {path}: {problem}{_ADVICE}")
 
 
 def load_camera(path: str | Path) -> Camera:
     """Read and validate camera.json; raises UserError saying what is wrong with it."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UserError(f"camera file {path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise UserError(f"camera file {path}: cannot read it ({error})") from None
-    try:
-        record = json.loads(text)
-    except json.JSONDecodeError as error:
-        raise _fail(path, f"not valid JSON ({error.msg} at line {error.lineno})") from None
+    record = read_json_file(path, f"camera file {path}", _ADVICE)
     if not isinstance(record, dict):
         raise _fail(path, "not a JSON object")
     missing = [key for key in ("image_size_px", "K", "dist") if key not in record]

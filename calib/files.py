@@ -12,13 +12,14 @@ that fails removes the folders it created, so a failed command leaves nothing be
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import secrets
 from pathlib import Path
 
 from bodyfit.calib.errors import UserError
 
-__all__ = ["check_writable_dir", "file_sha256", "write_atomic"]
+__all__ = ["read_json_file", "check_writable_dir", "file_sha256", "write_atomic"]
 
 
 def _nearest_existing(path: Path) -> Path:
@@ -99,3 +100,23 @@ def file_sha256(path: str | os.PathLike) -> str:
     except OSError as error:
         raise UserError(f"{path}: cannot read it ({error.strerror or error})") from None
     return digest.hexdigest()
+
+
+def read_json_file(path: str | os.PathLike, label: str, advice: str = ""):
+    """The parsed JSON of a user's file.
+
+    Raises:
+        UserError: ``"{label}: no such file"``, ``"... cannot read it (...)"`` or ``"... not
+            valid JSON (...){advice}"``.
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UserError(f"{label}: no such file") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise UserError(f"{label}: cannot read it ({error})") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as error:
+        raise UserError(f"{label}: not valid JSON ({error.msg} at line {error.lineno}){advice}"
+                        ) from None

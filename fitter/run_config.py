@@ -10,13 +10,13 @@ the working folder the run was started in (recorded as ``working_dir``).
 from __future__ import annotations
 
 import dataclasses
-import json
 import types
 import typing
 from pathlib import Path
 
 from bodyfit import kernels
 from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import read_json_file
 from bodyfit.fitter.canvas import CanvasSettings
 from bodyfit.fitter.fit import FitSettings
 from bodyfit.fitter.person import PersonInputs
@@ -123,14 +123,4 @@ def read_run_config(path) -> RunConfig:
     Raises:
         UserError: a missing, unreadable or non-JSON file, or a malformed record.
     """
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UserError(f"{path}: cannot read it ({exc.__class__.__name__})") from None
-    try:
-        record = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise UserError(f"{path}: not JSON (line {exc.lineno}: {exc.msg})") from None
-    return run_config(record, str(path))
+    return run_config(read_json_file(path, str(path)), str(path))

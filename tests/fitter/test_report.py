@@ -138,7 +138,7 @@ def test_config_into_its_own_folder_needs_overwrite(first_run, tmp_path, capsys)
 
 @pytest.mark.parametrize("content,message", [
     (None, "no such file"),
-    ("{", "not JSON"),
+    ("{", "not valid JSON"),
     ("[1]", "object"),
     ('{"inputs": {}}', "missing 'settings'"),
     ('{"inputs": {"front": "f.png"}, "settings": {}}', "missing 'side'"),
