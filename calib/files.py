@@ -11,6 +11,7 @@ that fails removes the folders it created, so a failed command leaves nothing be
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -19,13 +20,17 @@ from pathlib import Path
 
 from bodyfit.calib.errors import UserError
 
-__all__ = ["read_json_file", "check_writable_dir", "file_sha256", "write_atomic"]
+__all__ = ["read_json_file", "check_writable_dir", "created_folders", "file_sha256",
+           "write_atomic"]
 
 
-def _nearest_existing(path: Path) -> Path:
+def _missing_folders(path: Path) -> list[Path]:
+    """``path`` and its parents that do not exist, deepest first."""
+    missing = []
     while not path.exists() and path != path.parent:
+        missing.append(path)
         path = path.parent
-    return path
+    return missing
 
 
 def check_writable_dir(directory: str | os.PathLike) -> Path:
@@ -36,7 +41,8 @@ def check_writable_dir(directory: str | os.PathLike) -> Path:
     before any work starts, so that a long calibration does not end in a failed write.
     """
     path = Path(directory) if str(directory) else Path(".")
-    existing = _nearest_existing(path)
+    missing = _missing_folders(path)
+    existing = missing[-1].parent if missing else path
     if not existing.is_dir():
         raise UserError(f"output folder {str(path)!r} cannot be created: {str(existing)!r} is a file")
     if not os.access(existing, os.W_OK):
@@ -44,15 +50,22 @@ def check_writable_dir(directory: str | os.PathLike) -> Path:
     return path
 
 
-def _make_folders(folder: Path) -> list[Path]:
-    """Create ``folder`` and its missing parents; return those created, deepest first."""
-    missing = []
-    while not folder.exists():
-        missing.append(folder)
-        folder = folder.parent
-    for created in reversed(missing):
-        created.mkdir()
-    return missing
+@contextlib.contextmanager
+def created_folders(folder: str | os.PathLike):
+    """Create ``folder`` and its missing parents for the block; if the block (or a
+    ``mkdir``) fails, remove again the folders this made, so a failed command leaves no
+    empty folder behind. Raises OSError as ``mkdir`` does."""
+    made: list[Path] = []
+    try:
+        for missing in reversed(_missing_folders(Path(folder))):
+            missing.mkdir()
+            made.append(missing)
+        yield
+    except BaseException:
+        for missing in reversed(made):
+            with contextlib.suppress(OSError):  # something else wrote into it meanwhile
+                missing.rmdir()
+        raise
 
 
 def write_atomic(path: str | os.PathLike, payload: bytes) -> None:
@@ -66,25 +79,21 @@ def write_atomic(path: str | os.PathLike, payload: bytes) -> None:
     folder = check_writable_dir(target.parent)
     # open(..., "xb") rather than mkstemp: the file gets the umask's permissions, not 0600.
     temp_name = folder / f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}.part"
-    created: list[Path] = []
     temp_made = False
     try:
-        created = _make_folders(folder)
-        with open(temp_name, "xb") as stream:
-            temp_made = True
-            stream.write(payload)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.replace(temp_name, target)
-        temp_made = False
-        created = []
+        with created_folders(folder):
+            with open(temp_name, "xb") as stream:
+                temp_made = True
+                stream.write(payload)
+                stream.flush()
+                os.fsync(stream.fileno())
+            os.replace(temp_name, target)
+            temp_made = False
     except OSError as error:
         raise UserError(f"cannot write {target}: {error.strerror or error}") from None
     finally:
         if temp_made:  # only when open() succeeded: a name too long cannot even be unlinked
             temp_name.unlink(missing_ok=True)
-        for folder_made in created:
-            folder_made.rmdir()
 
 
 def file_sha256(path: str | os.PathLike) -> str:

@@ -14,7 +14,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from bodyfit.calib.files import write_atomic
+from bodyfit.calib.files import created_folders, write_atomic
 from bodyfit.fitter.measurements import MEASUREMENTS
 
 __all__ = ["staged_directory", "write_text", "write_json", "write_measurements",
@@ -27,16 +27,16 @@ def staged_directory(out_dir: Path):
     ``out_dir`` (created if needed), on any error delete it, so ``out_dir`` never holds the
     files of a failed run."""
     out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".partial",
-                                  dir=out_dir.parent))
-    try:
-        yield stage
-        out_dir.mkdir(exist_ok=True)
-        for item in sorted(stage.iterdir()):
-            item.replace(out_dir / item.name)
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
+    with created_folders(out_dir.parent):  # the same folder rule as every single file
+        stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".partial",
+                                      dir=out_dir.parent))
+        try:
+            yield stage
+            out_dir.mkdir(exist_ok=True)
+            for item in sorted(stage.iterdir()):
+                item.replace(out_dir / item.name)
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
 
 
 def write_text(path: Path, text: str) -> None:

@@ -111,3 +111,16 @@ def test_write_image_refuses_unknown_formats(tmp_path):
     with pytest.raises(UserError, match="cannot write"):
         write_image(tmp_path / "mask.xyz", np.zeros((4, 4), np.uint8))
     assert list(tmp_path.iterdir()) == []
+
+
+def test_created_folders_removes_what_it_made_when_the_block_fails(tmp_path):
+    from bodyfit.calib.files import created_folders
+
+    with pytest.raises(RuntimeError):
+        with created_folders(tmp_path / "a" / "b"):
+            assert (tmp_path / "a" / "b").is_dir()
+            raise RuntimeError("the command failed")
+    assert list(tmp_path.iterdir()) == []
+    with created_folders(tmp_path / "kept"):
+        pass
+    assert (tmp_path / "kept").is_dir()
