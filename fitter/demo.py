@@ -28,7 +28,7 @@ from bodyfit.calib.boards import parse_board
 from bodyfit.calib.camera import Camera, camera_fields
 from bodyfit.calib.camera_capture import capture_camera
 from bodyfit.calib.capture import Calibration, CaptureSettings
-from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import check_writable_dir
 from bodyfit.calib.synthetic import write_board_photos
 from bodyfit.fitter.body_model import POSE_NAMES, BodyModel
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
@@ -108,8 +108,7 @@ def write_scene(model: BodyModel, folder: Path, settings: DemoSettings = DemoSet
     photos, the board photos and truth.json into ``folder`` (created; files of an earlier
     demo there are replaced)."""
     folder = Path(folder)
-    if folder.exists() and not folder.is_dir():
-        raise UserError(f"output folder {folder} is a file")
+    check_writable_dir(folder)
     (folder / "board").mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(settings.seed)
     betas = np.clip(rng.standard_normal(settings.num_betas), -settings.beta_limit_sigma,

@@ -23,6 +23,7 @@ from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
 from bodyfit.fitter.contour import RigidFit, contour_points, normalise_contour, rigid_icp
 from bodyfit.fitter.render import PART_COLOURS_BGR, parts_legend
+from bodyfit.kernels.target import visible_faces
 
 __all__ = ["MatchedContours", "match_contours", "overlay_image", "fitted_outline_image",
            "OVERLAY_SCALE"]
@@ -97,10 +98,9 @@ def match_contours(model: BodyModel, posed: np.ndarray, view: kernels.ViewTarget
         view: the view's kernel target (camera, canvas size, person's mask, visible parts).
         device: where the kernels run.
     """
-    keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in view.visible_parts])
-    labels = kernels.rasterize(np.asarray(posed, np.float32)[None], model.faces[keep],
-                               model.face_parts[keep], view.camera, view.height, view.width,
-                               device).numpy()[0]
+    faces, face_parts = visible_faces(model.faces, model.face_parts, view.visible_parts)
+    labels = kernels.rasterize(np.asarray(posed, np.float32)[None], faces, face_parts,
+                               view.camera, view.height, view.width, device).numpy()[0]
     body = contour_points(labels >= 0)
     person = contour_points(view.silhouette)
     body_n, body_centre, body_scale = normalise_contour(body)

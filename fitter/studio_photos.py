@@ -25,32 +25,31 @@ given distance and height, its axis horizontal (:func:`pinhole_photo`;
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-import cv2
 import numpy as np
 
 from bodyfit.calib.camera import Camera, camera_fields
+from bodyfit.calib.images import write_image
 from bodyfit.calib.synthetic import distort_image
 
 from bodyfit.fitter.body_model import PART_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.outputs import write_json
 from bodyfit.fitter.pinhole_canvas import Placement
 from bodyfit.fitter.render import (coverage_mask, orthographic_pixels, pinhole_pixels,
                                    render_parts, render_pinhole)
-from bodyfit.fitter.side_arms import side_photo_pose
+from bodyfit.fitter.side_arms import SIDE_ARMS, side_photo_pose
+from bodyfit.kernels.target import SIDE_VIEW_PARTS, visible_faces
 
 BACKDROP_BGR = (170, 185, 200)
-SIDE_PARTS = ("head", "chest", "waist", "hip", "leg", "foot")
 
 
 def photo(vertices, model, view: str, parts, body_px: int = 700,
           size_px: tuple[int, int] = (600, 800)) -> np.ndarray:
     """(H, W, 3) uint8 BGR photo of posed ``vertices`` (V, 3) metres, one view."""
-    keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in parts])
-    faces = model.faces[keep]
-    image = render_parts(vertices, faces, model.face_parts[keep], view, body_px, margin_px=0)
+    faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
+    image = render_parts(vertices, faces, face_parts, view, body_px, margin_px=0)
     h, w = image.shape[:2]
     # the person's pixels: those the body covers by more than half (OpenCV's polygon fill
     # of the painted picture takes every pixel it touches, a pixel too wide)
@@ -77,12 +76,11 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
 
     The person's pixels are those the body covers by more than half (sub-pixel outline).
     """
-    keep = np.isin(model.face_parts, [PART_NAMES.index(p) for p in parts])
+    faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
     floor = float(vertices[:, 2].min())
     rotation, translation = Placement(distance_m, camera_height_m, 0.0, -floor).extrinsics(view)
-    faces = model.faces[keep]
-    image = render_pinhole(vertices, faces, model.face_parts[keep], intrinsics, rotation,
-                           translation, size_px)
+    image = render_pinhole(vertices, faces, face_parts, intrinsics, rotation, translation,
+                           size_px)
     body = coverage_mask(pinhole_pixels(vertices, intrinsics, rotation, translation)[0], faces,
                          size_px)
     canvas = np.full_like(image, BACKDROP_BGR)
@@ -94,7 +92,6 @@ __all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "write_subject", "write_pinhol
            "write_pinhole_subject"]
 
 
-SIDE_ARMS = ("down", "hidden")
 
 
 def write_subject(folder, model, betas, pose_deg, side_arms: str = "down") -> dict[str, float]:
@@ -110,8 +107,8 @@ def write_subject(folder, model, betas, pose_deg, side_arms: str = "down") -> di
     betas, pose_deg = np.atleast_2d(betas), np.atleast_2d(pose_deg)
     side, parts = _side_body(model, betas, pose_deg, side_arms)
     posed = forward(model, betas, pose_deg)[0]
-    cv2.imwrite(str(folder / "front.png"), photo(posed, model, "front", PART_NAMES))
-    cv2.imwrite(str(folder / "side.png"), photo(side, model, "side", parts))
+    write_image(folder / "front.png", photo(posed, model, "front", PART_NAMES))
+    write_image(folder / "side.png", photo(side, model, "side", parts))
     return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])
 
 
@@ -123,7 +120,7 @@ def _side_body(model, betas: np.ndarray, pose_deg: np.ndarray, side_arms: str):
     if side_arms == "down":
         side_pose = side_photo_pose(model, betas[0], pose_deg[0])[None]
         return forward(model, betas, side_pose)[0], PART_NAMES
-    return forward(model, betas, pose_deg)[0], SIDE_PARTS
+    return forward(model, betas, pose_deg)[0], SIDE_VIEW_PARTS
 
 
 def write_pinhole_photos(folder, model, betas, pose_deg, camera: Camera, distance_m: float,
@@ -146,7 +143,7 @@ def write_pinhole_photos(folder, model, betas, pose_deg, camera: Camera, distanc
                               camera.image_size_px, distance_m, camera_height_m)
         if np.any(camera.dist):
             image = distort_image(image, camera.K, camera.dist, BACKDROP_BGR)
-        cv2.imwrite(str(folder / f"{view}.png"), image)
+        write_image(folder / f"{view}.png", image)
     return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])
 
 
@@ -159,5 +156,5 @@ def write_pinhole_subject(folder, model, betas, pose_deg, intrinsics: np.ndarray
     camera = Camera(tuple(size_px), np.asarray(intrinsics, float), np.zeros(5))
     truth = write_pinhole_photos(folder, model, betas, pose_deg, camera, distance_m,
                                  camera_height_m, side_arms)
-    (Path(folder) / "camera.json").write_text(json.dumps(camera_fields(camera), indent=2))
+    write_json(Path(folder) / "camera.json", camera_fields(camera))
     return truth

@@ -152,6 +152,7 @@ def test_measure_other_topology_exit_2(body_model, tmp_path, capsys):
     (["model", "build", "--components", "0"], "--components"),
     (["demo", "--generations", "0"], "--generations"),
     (["demo", "-o", __file__], "is a file"),
+    (["demo", "-o", f"{__file__}/inside"], "is a file"),  # a parent that is a file
     (["model", "build", "-o", "model.txt"], "-o takes a .npz"),
 ])
 def test_bad_options_are_one_line_exit_2(capsys, argv, message):
