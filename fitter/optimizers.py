@@ -146,6 +146,11 @@ class Optimizer(abc.ABC):
         return self.lower.size
 
     @property
+    def best_cost(self) -> float:
+        """The best cost told so far (+inf before the first tell); cheaper than ``result``."""
+        return self._best_cost
+
+    @property
     @abc.abstractmethod
     def population_size(self) -> int:
         """P, the number of candidates the next ``ask()`` returns."""

@@ -10,10 +10,9 @@ from __future__ import annotations
 import base64
 import html
 
-import cv2
 import numpy as np
 
-from bodyfit.calib.errors import UserError
+from bodyfit.calib.images import encode_image
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 
 __all__ = ["REPORT_PICTURES", "png_data_uri", "report_html"]
@@ -48,10 +47,7 @@ code { font-size: 0.95em; word-break: break-all; }
 
 def png_data_uri(image: np.ndarray) -> str:
     """``data:image/png;base64,...`` of a (H, W, 3) uint8 BGR picture."""
-    ok, encoded = cv2.imencode(".png", image)
-    if not ok:
-        raise UserError("could not encode a report picture as PNG")
-    return "data:image/png;base64," + base64.b64encode(encoded.tobytes()).decode("ascii")
+    return "data:image/png;base64," + base64.b64encode(encode_image(image, ".png")).decode("ascii")
 
 
 def _e(value) -> str:
@@ -100,13 +96,13 @@ def _weight_rows(weights: dict[str, float]) -> list[tuple[str, str]]:
     return [(name, f"{value:g}") for name, value in weights.items()]
 
 
-def report_html(record: dict, weights: dict[str, float], values: dict[str, float],
-                spreads: dict[str, float], images: dict[str, np.ndarray]) -> str:
+def report_html(record: dict, values: dict[str, float], spreads: dict[str, float],
+                images: dict[str, np.ndarray]) -> str:
     """The report page.
 
     Args:
-        record: the run.json payload (:func:`bodyfit.fitter.run.run_record`).
-        weights: weight name -> value (:func:`bodyfit.fitter.weights.weights_record`).
+        record: the run.json payload (:func:`bodyfit.fitter.run.run_record`), its weights
+            included.
         values, spreads: measurement key ("A".."P") -> mm.
         images: one (H, W, 3) uint8 BGR picture per key of ``REPORT_PICTURES``.
     """
@@ -151,7 +147,7 @@ point's body part.</p>
 <div class="row">{_figure("convergence", images)}</div>
 <div class="tables">
 <div><h3>Settings</h3><table>{_rows(_settings_rows(record))}</table></div>
-<div><h3>Weights</h3><table>{_rows(_weight_rows(weights), numeric=True)}</table></div>
+<div><h3>Weights</h3><table>{_rows(_weight_rows(record["weights"]), numeric=True)}</table></div>
 <div><h3>Best cost (weighted mm)</h3><table>{_rows(terms, numeric=True)}</table></div>
 <div><h3>Timings</h3><table>{_rows(timings, numeric=True)}</table></div>
 </div>

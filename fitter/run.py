@@ -74,6 +74,7 @@ def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fi
         "output": str(out_dir),
         "working_dir": os.getcwd(),
         "settings": dataclasses.asdict(settings),
+        "weights": weights_record(settings.cost),
         "cost_terms": list(kernels.TERM_NAMES),
         "model": {"settings": model.metadata.get("settings"),
                   "anny_version": model.metadata.get("anny_version")},
@@ -124,6 +125,6 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
             pictures[f"overlay_{name}"] = overlay_image(matched)
             pictures[f"outline_{name}"] = fitted_outline_image(matched)
             write_image(stage / f"overlay_{name}.png", pictures[f"overlay_{name}"])
-        write_text(stage / "report.html", report_html(record, weights_record(settings.cost),
-                                                      fit.measurements, fit.spreads, pictures))
+        write_text(stage / "report.html",
+                   report_html(record, fit.measurements, fit.spreads, pictures))
     return fit, [out_dir / name for name in RUN_FILES]

@@ -150,7 +150,7 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
             costs = evaluator.evaluate(betas_of(genes), genes[:, k:]).costs.astype(np.float64)
             optimizer.tell(genes, costs)
             finite = costs[np.isfinite(costs)]
-            best_costs.append(optimizer.result.best_cost)
+            best_costs.append(optimizer.best_cost)
             mean_costs.append(float(finite.mean()) if finite.size else np.inf)
             bar.update(1)
             bar.set_postfix(best=f"{best_costs[-1]:.1f}")

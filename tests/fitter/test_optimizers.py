@@ -325,3 +325,14 @@ def test_factory_names_and_options():
         make_optimizer("ga", LOWER, UPPER[:-1])
     with pytest.raises(ValueError):
         make_optimizer("cmaes", UPPER, LOWER)
+
+
+@pytest.mark.parametrize("name", ["ga", "cmaes"])
+def test_best_cost_is_the_results(name):
+    lower, upper = search_bounds(4)
+    opt = make_optimizer(name, lower, upper, population=8, generations=3, seed=2)
+    assert opt.best_cost == np.inf
+    while not opt.stop():
+        x = opt.ask()
+        opt.tell(x, np.sum(x ** 2, axis=1))
+        assert opt.best_cost == opt.result.best_cost
