@@ -35,6 +35,8 @@ from bodyfit.kernels.boundary import scan_label_maps
 from bodyfit.kernels.device import resolve_device
 
 __all__ = [
+    "VERTICAL_ANCHORS",
+    "anchors_on_extremes",
     "SilhouetteMoments",
     "WarpSilhouetteMoments",
     "silhouette_moments",
@@ -42,6 +44,19 @@ __all__ = [
     "launch_alignment",
     "align_label_maps",
 ]
+
+
+#: How candidates are shifted vertically onto the person (:func:`launch_alignment`).
+VERTICAL_ANCHORS = ("centroid", "extremes")
+
+
+def anchors_on_extremes(vertical_anchor: str) -> bool:
+    """Whether ``vertical_anchor`` is ``"extremes"``; ValueError unless one of
+    ``VERTICAL_ANCHORS``."""
+    if vertical_anchor not in VERTICAL_ANCHORS:
+        raise ValueError(f"vertical_anchor must be one of {VERTICAL_ANCHORS}, "
+                         f"got {vertical_anchor!r}")
+    return vertical_anchor == "extremes"
 
 
 @wp.struct
@@ -123,7 +138,7 @@ def rigid_transform(candidate: SilhouetteMoments, target: SilhouetteMoments,
     out = np.eye(3)
     out[:2, :2] = rot
     out[:2, 2] = candidate.centroid - rot @ target.centroid
-    if vertical_anchor == "extremes":
+    if anchors_on_extremes(vertical_anchor):
         person_mid = np.array([target.centroid[0], (target.top[1] + target.bottom[1]) / 2])
         moved = rot @ person_mid + out[:2, 2]
         out[1, 2] += (candidate.top[1] + candidate.bottom[1]) / 2 - moved[1]
@@ -205,7 +220,7 @@ def launch_alignment(row_moments: wp.array, target: WarpSilhouetteMoments, align
     """
     wp.launch(_align_kernel, dim=row_moments.shape[0], device=row_moments.device,
               inputs=[row_moments, target, int(align_rotation),
-                      int(vertical_anchor == "extremes")],
+                      int(anchors_on_extremes(vertical_anchor))],
               outputs=[transforms, extremes, areas])
 
 

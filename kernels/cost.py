@@ -30,12 +30,11 @@ import dataclasses
 import warp as wp
 
 from bodyfit.kernels.body_layout import PART_NAMES
-from bodyfit.kernels.alignment import WarpSilhouetteMoments
+from bodyfit.kernels.alignment import WarpSilhouetteMoments, anchors_on_extremes
 from bodyfit.kernels.boundary import run_end, run_part, run_start, transform_point
 
 __all__ = [
     "MATCHING_DIRECTIONS",
-    "VERTICAL_ANCHORS",
     "MATCHING_WEIGHTS",
     "TERM_NAMES",
     "CostSettings",
@@ -53,8 +52,7 @@ TERM_NAMES = PART_NAMES + ("top", "bottom")
 MATCHING_WEIGHTS = {"person_to_model": (1.0, 0.0), "model_to_person": (0.0, 1.0),
                     "symmetric": (0.5, 0.5)}
 MATCHING_DIRECTIONS = tuple(MATCHING_WEIGHTS)
-#: How candidates are shifted vertically onto the person (CostSettings.vertical_anchor).
-VERTICAL_ANCHORS = ("centroid", "extremes")
+
 
 PartVector = wp.types.vector(length=NUM_PARTS, dtype=wp.float32)
 
@@ -92,9 +90,7 @@ class CostSettings:
                    self.side_weight)
         if any(not w >= 0 for w in weights):
             raise ValueError("cost weights must be >= 0")
-        if self.vertical_anchor not in VERTICAL_ANCHORS:
-            raise ValueError(f"vertical_anchor must be one of {VERTICAL_ANCHORS}, "
-                             f"got {self.vertical_anchor!r}")
+        anchors_on_extremes(self.vertical_anchor)  # ValueError for an unknown one
         if self.matching not in MATCHING_DIRECTIONS:
             raise ValueError(f"matching must be one of {MATCHING_DIRECTIONS}, "
                              f"got {self.matching!r}")

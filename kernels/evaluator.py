@@ -132,8 +132,10 @@ class PopulationEvaluator:
         self.profile = profile
         self.stage_seconds = dict.fromkeys(STAGES, 0.0)
         self._views = [_ViewState(v, model, settings) for v in views]
-        #: the distinct ``fixed_pose_deg`` of the views: one skinning per chunk each
-        self._view_poses = list(dict.fromkeys(v.fixed_pose_deg for v in views))
+        #: the views by their ``fixed_pose_deg``: one skinning per chunk for each group
+        self._pose_groups: dict[tuple, list[_ViewState]] = {}
+        for state in self._views:
+            self._pose_groups.setdefault(state.view.fixed_pose_deg, []).append(state)
         self._capacity = 0
         self._timer = time.perf_counter if model.device.is_cuda else time.process_time
         self._clock = 0.0
@@ -145,9 +147,8 @@ class PopulationEvaluator:
             state.allocate(capacity)
         self._joints = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.vec3, device=dev)
         self._rotations = wp.empty((capacity, len(POSE_NAMES)), dtype=wp.mat33, device=dev)
-        self._vertices = {fixed: wp.empty((capacity, self.model.num_vertices), dtype=wp.vec3,
-                                          device=dev)
-                          for fixed in self._view_poses}
+        self._vertices = wp.empty((capacity, self.model.num_vertices), dtype=wp.vec3,
+                                  device=dev)
         self._term_costs = wp.empty((capacity, len(TERM_NAMES)), dtype=wp.float32, device=dev)
         self._costs = wp.empty(capacity, dtype=wp.float32, device=dev)
         self._capacity = capacity
@@ -155,7 +156,6 @@ class PopulationEvaluator:
     def buffer_bytes(self) -> int:
         """Bytes of device memory held by this evaluator (model data excluded)."""
         arrays = [v for v in vars(self).values() if isinstance(v, wp.array)]
-        arrays += list(getattr(self, "_vertices", {}).values())
         arrays += [a for state in self._views for a in state.arrays()]
         return sum(a.capacity for a in arrays)
 
@@ -184,29 +184,27 @@ class PopulationEvaluator:
         total = dims["P"]
         if min(total, self.chunk_size) > self._capacity:
             self._allocate(min(total, self.chunk_size))
-        poses = {fixed: _fixed_angles(pose_deg, fixed) for fixed in self._view_poses}
         costs = np.empty(total, np.float32)
         part_costs = np.empty((total, len(TERM_NAMES)), np.float32)
         for start in range(0, total, self.chunk_size):
             stop = min(start + self.chunk_size, total)
             costs[start:stop], part_costs[start:stop] = self._evaluate_chunk(
-                betas[start:stop], {fixed: pose[start:stop] for fixed, pose in poses.items()})
+                betas[start:stop], pose_deg[start:stop])
         return PopulationCost(costs, part_costs)
 
-    def _evaluate_chunk(self, betas: wp.array, poses: dict[tuple, wp.array]):
+    def _evaluate_chunk(self, betas: wp.array, pose_deg: wp.array):
         num = betas.shape[0]
         self._clock = self._timer()
         term_costs, costs = self._term_costs[:num], self._costs[:num]
         term_costs.zero_()
         costs.zero_()
-        for fixed, pose_deg in poses.items():
-            vertices = self._vertices[fixed][:num]
+        vertices = self._vertices[:num]  # each pose group's views are done with it in turn
+        for fixed, states in self._pose_groups.items():
             launch_skinning(self.model, betas, pose_deg, self._joints[:num],
-                            self._rotations[:num], vertices)
+                            self._rotations[:num], vertices, fixed)
             self._stage_done("skin")
-            for state in self._views:
-                if state.view.fixed_pose_deg == fixed:
-                    self._evaluate_view(state, vertices, term_costs, costs)
+            for state in states:
+                self._evaluate_view(state, vertices, term_costs, costs)
         out = costs.numpy(), term_costs.numpy()
         self._stage_done("cost")
         return out
@@ -236,16 +234,6 @@ class PopulationEvaluator:
                          transforms, extremes, areas, term_costs, costs)
         self._stage_done("cost")
 
-
-def _fixed_angles(pose_deg: wp.array, fixed: tuple[tuple[int, float], ...]) -> wp.array:
-    """(P, 4) float32 degrees: ``pose_deg`` with the angles of ``fixed``
-    (``ViewTarget.fixed_pose_deg``) put in; ``pose_deg`` itself when there are none."""
-    if not fixed:
-        return pose_deg
-    pose = pose_deg.numpy().copy()  # on a CPU device .numpy() shares the memory
-    for column, degrees in fixed:
-        pose[:, column] = degrees
-    return wp.array(pose, dtype=wp.float32, device=pose_deg.device)
 
 
 def evaluate_population(model: ModelArrays, views: Sequence[ViewTarget], betas, pose_deg,

@@ -103,11 +103,15 @@ def _shape_blend(mean: wp.vec3, dirs: wp.array2d(dtype=wp.vec3), row: int,
 
 @wp.kernel(enable_backward=False)
 def _joints_kernel(space: ShapeSpace, betas: wp.array2d(dtype=wp.float32),
-                   pose_deg: wp.array2d(dtype=wp.float32), joints: wp.array2d(dtype=wp.vec3),
+                   pose_deg: wp.array2d(dtype=wp.float32), fixed_deg: wp.vec4,
+                   is_fixed: wp.vec4, joints: wp.array2d(dtype=wp.vec3),
                    rotations: wp.array2d(dtype=wp.mat33)):
     p, c = wp.tid()
     joints[p, c] = _shape_blend(space.mean_joints[c], space.joint_dirs, c, betas, p)
-    theta = wp.radians(pose_deg[p, c]) * space.chain_sides[c]
+    angle = pose_deg[p, c]
+    if is_fixed[c] > 0.0:
+        angle = fixed_deg[c]
+    theta = wp.radians(angle) * space.chain_sides[c]
     cs = wp.cos(theta)
     sn = wp.sin(theta)
     rotations[p, c] = wp.mat33(cs, 0.0, -sn, 0.0, 1.0, 0.0, sn, 0.0, cs)
@@ -183,7 +187,8 @@ class ModelArrays:
 
 
 def launch_skinning(model: ModelArrays, betas: wp.array, pose_deg: wp.array,
-                    joints: wp.array, rotations: wp.array, vertices: wp.array) -> None:
+                    joints: wp.array, rotations: wp.array, vertices: wp.array,
+                    fixed_pose_deg: tuple[tuple[int, float], ...] = ()) -> None:
     """Launch the skinning kernels on checked arrays (no allocation, no checks).
 
     Args:
@@ -192,10 +197,16 @@ def launch_skinning(model: ModelArrays, betas: wp.array, pose_deg: wp.array,
         joints: (P, 4) vec3 scratch, metres.
         rotations: (P, 4) mat33 scratch.
         vertices: (P, V) vec3 output, metres, model frame.
+        fixed_pose_deg: ((pose column, degrees), ...): angles every candidate takes instead
+            of its own (``ViewTarget.fixed_pose_deg``, e.g. a side view's arms down).
     """
     num = betas.shape[0]
+    fixed_deg, is_fixed = [0.0] * NUM_CHAINS, [0.0] * NUM_CHAINS
+    for column, degrees in fixed_pose_deg:
+        fixed_deg[column], is_fixed[column] = degrees, 1.0
     wp.launch(_joints_kernel, dim=(num, NUM_CHAINS), device=model.device,
-              inputs=[model.space, betas, pose_deg], outputs=[joints, rotations])
+              inputs=[model.space, betas, pose_deg, wp.vec4(*fixed_deg), wp.vec4(*is_fixed)],
+              outputs=[joints, rotations])
     wp.launch(_skin_kernel, dim=(num, model.num_vertices), device=model.device,
               inputs=[model.space, betas, joints, rotations], outputs=[vertices])
 

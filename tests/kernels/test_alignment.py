@@ -91,3 +91,9 @@ def test_extremes_anchor_puts_the_middle_rows_together(person_and_moved):
         assert (extremes @ middle)[1] == pytest.approx(
             (candidate.top[1] + candidate.bottom[1]) / 2, abs=1e-3)
         assert extremes[0, 2] == pytest.approx(centroid[0, 2], abs=1e-4)
+
+
+def test_unknown_vertical_anchor_is_an_error(person_and_moved):
+    person, moved = person_and_moved
+    with pytest.raises(ValueError, match="vertical_anchor must be one of"):
+        align_label_maps(moved, silhouette_moments(person >= 0), vertical_anchor="extreme")
