@@ -27,6 +27,7 @@ import numpy as np
 
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import write_atomic
+from bodyfit.kernels.body_forward import abduction_rotations, forward, rest_shape  # re-exported
 from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES, POSE_SIDES  # re-exported
 
 __all__ = [
@@ -186,25 +187,6 @@ class BodyModel:
             raise UserError("body model faces are inconsistent; run `fitter model build`")
 
 
-def rest_shape(model: BodyModel, betas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Eq. 1: rest-pose vertices and rig joints of each body.
-
-    Args:
-        betas: (P, K) float, shape coefficients in units of standard deviation, K <= C.
-
-    Returns:
-        vertices: (P, V, 3) float32, metres, model frame.
-        joints: (P, 4, 3) float32, metres.
-    """
-    betas = np.asarray(betas, dtype=np.float32)
-    if betas.ndim != 2:
-        raise ValueError(f"betas must have shape (P, K), got {betas.shape}")
-    vertex_dirs, joint_dirs = model.shape_directions(betas.shape[1])
-    vertices = model.mean_vertices + np.einsum("pk,kvd->pvd", betas, vertex_dirs)
-    joints = model.mean_joints + np.einsum("pk,kjd->pjd", betas, joint_dirs)
-    return vertices.astype(np.float32), joints.astype(np.float32)
-
-
 def project_shape(model: BodyModel, vertices: np.ndarray, joints: np.ndarray,
                   num_betas: int) -> np.ndarray:
     """The inverse of :func:`rest_shape`: betas of the closest bodies of the space.
@@ -225,52 +207,3 @@ def project_shape(model: BodyModel, vertices: np.ndarray, joints: np.ndarray,
     comps = np.concatenate([model.vertex_components[:k].reshape(k, -1),
                             model.joint_components[:k].reshape(k, -1)], axis=1)
     return (x.astype(np.float64) @ comps.T.astype(np.float64)) / np.sqrt(model.eigenvalues[:k])
-
-
-def abduction_rotations(pose_deg: np.ndarray) -> np.ndarray:
-    """Rotation matrices of the four chains, in the frontal (x-z) plane about the y axis.
-
-    A positive angle moves the limb away from the midline: the left chains (+x side) turn
-    a downward vector (0, 0, -1) towards +x, the right chains towards -x.
-
-    Args:
-        pose_deg: (P, 4) float, degrees, in ``POSE_NAMES`` order.
-
-    Returns:
-        (P, 4, 3, 3) float64 rotation matrices acting on column vectors (x, y, z).
-    """
-    theta = np.deg2rad(np.asarray(pose_deg, dtype=np.float64)) * POSE_SIDES
-    c, s = np.cos(theta), np.sin(theta)
-    rot = np.zeros(theta.shape + (3, 3))
-    rot[..., 0, 0] = c
-    rot[..., 0, 2] = -s
-    rot[..., 1, 1] = 1.0
-    rot[..., 2, 0] = s
-    rot[..., 2, 2] = c
-    return rot
-
-
-def forward(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
-    """NumPy reference forward (Eq. 1-3): shape blend, then linear blend skinning.
-
-    The Warp kernels of :mod:`bodyfit.kernels` are checked against this function.
-
-    Args:
-        betas: (P, K) float, shape coefficients in units of standard deviation.
-        pose_deg: (P, 4) float, abduction angles in degrees, ``POSE_NAMES`` order.
-
-    Returns:
-        (P, V, 3) float32 posed vertices, metres, model frame.
-    """
-    pose_deg = np.asarray(pose_deg, dtype=np.float64)
-    betas = np.asarray(betas)
-    if betas.ndim != 2 or pose_deg.shape != (betas.shape[0], len(POSE_NAMES)):
-        raise ValueError(f"betas must be (P, K) and pose (P, 4); got {betas.shape} "
-                         f"and {pose_deg.shape}")
-    rest, joints = rest_shape(model, betas)
-    rot = abduction_rotations(pose_deg)  # (P, 4, 3, 3)
-    offset = rest[:, None, :, :] - joints[:, :, None, :]  # (P, 4, V, 3)
-    moved = np.einsum("pcij,pcvj->pcvi", rot, offset) + joints[:, :, None, :]
-    delta = moved - rest[:, None, :, :]  # (P, 4, V, 3)
-    posed = rest + np.einsum("vc,pcvd->pvd", model.chain_weights, delta)
-    return posed.astype(np.float32)

@@ -2,9 +2,8 @@
 
 Written independently of the kernels and for clarity, not speed:
 
-- skinning: :func:`skin_reference`, the paper's Eq. 1-3 in float64 NumPy, one rotation
-  matrix per chain (the body model's own NumPy forward,
-  :func:`bodyfit.fitter.body_model.forward`, is the same maths; the tests check both);
+- skinning: the body model's NumPy forward, :func:`bodyfit.kernels.body_forward.forward`
+  (the paper's Eq. 1-3);
 - projection: the camera equations in float64;
 - rasterisation: ``cv2.fillPoly`` of every projected triangle (no back-face culling),
   painted far to near by mean depth (the painter's algorithm). ``cv2.fillPoly`` also draws
@@ -24,47 +23,19 @@ import cv2
 import numpy as np
 from scipy.spatial import cKDTree
 
-from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES, POSE_SIDES
+from bodyfit.kernels.body_forward import forward
+from bodyfit.kernels.body_layout import PART_NAMES
 from bodyfit.kernels.alignment import rigid_transform, silhouette_moments
 from bodyfit.kernels.view_camera import ViewCamera, camera_matrices
 from bodyfit.kernels.cost import MATCHING_WEIGHTS, TERM_NAMES, CostSettings
 from bodyfit.kernels.skinning import SkinnableModel
 from bodyfit.kernels.target import ViewTarget, boundary_mask, visible_faces
 
-__all__ = ["skin_reference", "project_vertices", "render_label_maps", "interpolate_distance",
+__all__ = ["project_vertices", "render_label_maps", "interpolate_distance",
            "view_terms", "population_cost"]
 
 _SHIFT = 8  # fixed-point bits of the cv2.fillPoly coordinates
 _BAND_PIXELS = 1 << 20  # fine-grid pixels painted per band
-
-
-def skin_reference(model: SkinnableModel, betas, pose_deg) -> np.ndarray:
-    """(P, V, 3) float64 posed vertices, metres, model frame: shape blend, then LBS.
-
-    Args:
-        model: a body model (the attributes of :class:`bodyfit.kernels.skinning.SkinnableModel`).
-        betas: (P, K) float, shape coefficients in units of standard deviation.
-        pose_deg: (P, 4) float, abduction angles in degrees, ``POSE_NAMES`` order.
-    """
-    betas = np.asarray(betas, dtype=np.float64)
-    pose_deg = np.asarray(pose_deg, dtype=np.float64)
-    if betas.ndim != 2 or pose_deg.shape != (len(betas), len(POSE_NAMES)):
-        raise ValueError(f"betas must be (P, K) and pose_deg (P, 4); got {betas.shape} "
-                         f"and {pose_deg.shape}")
-    vertex_dirs, joint_dirs = model.shape_directions(betas.shape[1])
-    rest = model.mean_vertices + np.einsum("pk,kvd->pvd", betas, vertex_dirs)
-    joints = model.mean_joints + np.einsum("pk,kcd->pcd", betas, joint_dirs)
-    posed = rest.copy()
-    for c in range(len(POSE_NAMES)):
-        theta = np.deg2rad(pose_deg[:, c]) * POSE_SIDES[c]  # about the y axis, x-z plane
-        cos, sin = np.cos(theta), np.sin(theta)
-        rotation = np.zeros((len(betas), 3, 3))
-        rotation[:, 0, 0], rotation[:, 0, 2], rotation[:, 1, 1] = cos, -sin, 1.0
-        rotation[:, 2, 0], rotation[:, 2, 2] = sin, cos
-        joint = joints[:, c, None, :]
-        moved = np.einsum("pij,pvj->pvi", rotation, rest - joint) + joint
-        posed += model.chain_weights[None, :, c, None] * (moved - rest)
-    return posed
 
 
 def project_vertices(camera: ViewCamera, vertices: np.ndarray) -> np.ndarray:
@@ -180,7 +151,7 @@ def population_cost(model: SkinnableModel, betas: np.ndarray, pose_deg: np.ndarr
     """
     part_costs = np.zeros((len(betas), len(TERM_NAMES)))
     for view in views:
-        vertices = skin_reference(model, betas, view.view_pose(pose_deg))
+        vertices = forward(model, betas, view.view_pose(pose_deg))
         faces, face_parts = visible_faces(model.faces, model.face_parts, view.visible_parts)
         screen = project_vertices(view.camera, vertices)
         maps = render_label_maps(screen, faces, face_parts, view.height, view.width,

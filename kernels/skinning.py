@@ -1,7 +1,7 @@
 """The body model on a device, and skinning: (P, K) betas + (P, 4) pose -> (P, V, 3) vertices.
 
-The same maths as the body model's NumPy forward (:func:`bodyfit.fitter.body_model.forward`,
-and :func:`bodyfit.kernels.reference.skin_reference`; the paper's Eq. 1-3):
+The same maths as the body model's NumPy forward (:func:`bodyfit.kernels.body_forward.forward`,
+re-exported as ``bodyfit.fitter.body_model.forward``; the paper's Eq. 1-3):
 
     rest_i  = mean_i + sum_k betas[k] * vertex_dirs[k, i]                 (shape blend)
     joint_c = mean_joint_c + sum_k betas[k] * joint_dirs[k, c]

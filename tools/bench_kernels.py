@@ -168,7 +168,7 @@ def main() -> None:
     agreement = np.median(np.abs(kernel_costs - reference_costs) / reference_costs)
     largest = max(args.populations)
     ratio = totals[largest] * reference_s
-    print(f"NumPy/OpenCV reference (skin_reference, cv2.fillPoly far to near, cKDTree): "
+    print(f"NumPy/OpenCV reference (NumPy forward, cv2.fillPoly far to near, cKDTree): "
           f"{1e3 * reference_s:.1f} ms per cv on {args.reference_candidates} candidates; "
           f"kernels at P = {largest}: {ratio:.0f}x faster (target >= {REFERENCE_TARGET_RATIO:.0f}x: "
           f"{'met' if ratio >= REFERENCE_TARGET_RATIO else 'missed'}). Median cost difference "

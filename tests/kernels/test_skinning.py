@@ -10,7 +10,6 @@ import warp as wp
 
 from bodyfit.fitter.body_model import forward
 from bodyfit.kernels.device import resolve_device
-from bodyfit.kernels.reference import skin_reference
 from bodyfit.kernels.skinning import ModelArrays, skin
 
 from kernel_scenes import DEVICES, random_bodies
@@ -25,13 +24,6 @@ def test_skin_matches_numpy_forward(body_model, device):
     expected = forward(body_model, betas, pose)
     assert posed.shape == expected.shape == (6, body_model.num_vertices, 3)
     assert np.abs(posed - expected).max() < 1e-5
-
-
-def test_numpy_skin_reference_matches_the_body_models_forward(body_model):
-    betas, pose = random_bodies(4, seed=3, spread=3.0)
-    pose[0] = [30.0, -5.0, 10.0, 45.0]
-    expected = forward(body_model, betas, pose)
-    assert np.abs(skin_reference(body_model, betas, pose) - expected).max() < 1e-5
 
 
 def test_skin_moves_only_the_posed_chain(body_model, model_arrays):
