@@ -167,9 +167,10 @@ class ModelArrays:
         """
         dev = resolve_device(device)
         if not 1 <= num_betas <= model.num_components:
-            raise ValueError(
-                f"the body model stores {model.num_components} shape components; "
-                f"asked for {num_betas}. Rebuild it with `fitter model build --components N`.")
+            raise ValueError(f"the body model stores {model.num_components} shape components; "
+                             f"asked for {num_betas}")
+        if model.face_parts.max() >= len(PART_NAMES):
+            raise ValueError("the model's part labels exceed PART_NAMES")
         vertex_dirs, joint_dirs = model.shape_directions(num_betas)
         space = ShapeSpace()
         space.mean_vertices = wp.array(model.mean_vertices, dtype=wp.vec3, device=dev)
@@ -180,8 +181,6 @@ class ModelArrays:
                                     dtype=wp.vec3, device=dev)
         space.chain_weights = wp.array(model.chain_weights, dtype=wp.float32, device=dev)
         space.chain_sides = wp.array(POSE_SIDES.astype(np.float32), dtype=wp.float32, device=dev)
-        if model.face_parts.max() >= len(PART_NAMES):
-            raise ValueError("the model's part labels exceed PART_NAMES")
         return cls(space, model.faces.astype(np.int32), model.face_parts, num_betas,
                    model.num_vertices, dev)
 
