@@ -254,6 +254,8 @@ def _solve(
     """(rms_px, K (3, 3), dist (n,), intrinsic std (18,), per-view RMS (views,)) from OpenCV."""
     object_points = [view.detection.object_points for view in views]
     image_points = [view.detection.image_points for view in views]
+    threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)  # OpenCV's threaded solve differs in the last bits from run to run
     try:
         rms, K, dist, _, _, std, _, errors = cv2.calibrateCameraExtended(
             object_points, image_points, image_size, None, None, flags=flags, criteria=_SOLVE_CRITERIA
@@ -263,6 +265,8 @@ def _solve(
             f"the calibration solve failed ({str(error).strip().splitlines()[-1]}); "
             "photograph the board from more varied angles (tilted 20-45 degrees)"
         ) from None
+    finally:
+        cv2.setNumThreads(threads)
     if not np.isfinite(rms) or not np.isfinite(K).all() or not np.isfinite(dist).all():
         raise UserError("the calibration solve diverged; photograph the board from more varied angles")
     return rms, K, dist.reshape(-1), std.reshape(-1), errors.reshape(-1)

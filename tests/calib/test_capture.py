@@ -126,3 +126,16 @@ def test_video_frames_are_sampled_and_repeated_positions_skipped(tmp_path, charu
     assert statuses == [ViewStatus.USED, ViewStatus.DUPLICATE] * 8
     calibration = calibrate(views, size, settings, spec)
     assert calibration.camera.K[0, 0] == pytest.approx(small_k[0, 0], rel=0.01)
+
+
+def test_the_same_views_give_the_same_camera_to_the_last_bit(chessboard_shots):
+    """The solve runs single-threaded: OpenCV's threaded solve differed in the last bits
+    from run to run, and the fit downstream amplifies such differences (docs/fitter.md)."""
+    views, size = collect_views([str(p) for p in chessboard_shots.sharp], BoardDetector(chessboard_shots.spec),
+                                SETTINGS)
+    threads = cv2.getNumThreads()
+    cameras = [calibrate(views, size, SETTINGS, chessboard_shots.spec).camera for _ in range(4)]
+    for camera in cameras[1:]:
+        np.testing.assert_array_equal(camera.K, cameras[0].K)
+        np.testing.assert_array_equal(camera.dist, cameras[0].dist)
+    assert cv2.getNumThreads() == threads  # restored for the rest of the program
