@@ -132,6 +132,8 @@ def _build_parser() -> argparse.ArgumentParser:
                           "instead of solving it so every candidate stands as tall as the "
                           "person")
     run.add_argument("--device", help="cpu (default) or cuda:0")
+    run.add_argument("--threads", type=int, help="CPU threads scoring each generation "
+                     "(default: one per core; the result does not depend on it)")
     run.add_argument("--overwrite", action="store_true", help="write into a non-empty OUT")
 
     measure = sub.add_parser("measure", help="the 16 measurements (mm) of a mesh in the "
@@ -272,6 +274,7 @@ def _run_settings(args):
         cost = settings_from_record(record, cost)
     settings = dataclasses.replace(settings, search=search, cost=cost,
                                    device=given.get("device", settings.device),
+                                   threads=given.get("threads", settings.threads),
                                    side_arms=given.get("side_arms", settings.side_arms),
                                    projection=given.get("projection", settings.projection))
     return inputs, settings, output
