@@ -337,12 +337,12 @@ def _cmd_run(args) -> None:
 def _batch_engine(args, model_sha256: str):
     """The engine of `fitter batch`'s options: local processes, or Ray."""
     import dataclasses
-    import logging as logs
 
     from bodyfit.fitter.batch.engines import LocalEngine, WorkerSetup, cpu_count
 
     device = args.device or "cpu"
-    setup = WorkerSetup(model_sha256, log_level=logs.ERROR if args.quiet else logs.WARNING)
+    setup = WorkerSetup(model_sha256,
+                        log_level=logging.ERROR if args.quiet else logging.WARNING)
     if args.ray or args.ray_address:
         from bodyfit.fitter.batch.ray_engine import RayEngine
 
@@ -402,7 +402,8 @@ def _batch_jobs(args):
             jobs[row.subject_id] = subject_job(row, base, options, args.output.absolute())
         except UserError as exc:  # the row's weights file
             bad_rows.append(BadRow(row.line, row.subject_id, str(exc)))
-    table = dataclasses.replace(table, rows=[row for row in table.rows if row.subject_id in jobs],
+    table = dataclasses.replace(table, rows=[row for row in table.rows
+                                             if row.subject_id in jobs],
                                 bad_rows=sorted(bad_rows, key=lambda bad: bad.line))
     if table.bad_rows and not args.skip_bad_rows:
         more = len(table.bad_rows) - 1

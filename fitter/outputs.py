@@ -32,10 +32,10 @@ def staged_directory(out_dir: Path):
     """Yield a fresh staging directory beside ``out_dir``; on success move it into place,
     on any error delete it, so ``out_dir`` never holds the files of a failed run.
 
-    When ``out_dir`` does not exist yet the staging directory is renamed to it, one atomic
-    step: a process killed at any moment leaves ``out_dir`` complete or absent (and at
-    worst a staging directory, named as ``STAGE_PATTERN`` says). Otherwise its
-    files are moved into ``out_dir`` one by one.
+    When ``out_dir`` does not exist yet (or, on POSIX, is an empty folder) the staging
+    directory is renamed to it, one atomic step: a process killed at any moment leaves
+    ``out_dir`` complete or absent (and at worst a staging directory, named as
+    ``STAGE_PATTERN`` says). Otherwise its files are moved into ``out_dir`` one by one.
     """
     out_dir = Path(out_dir)
     with created_folders(out_dir.parent):  # the same folder rule as every single file
@@ -45,9 +45,9 @@ def staged_directory(out_dir: Path):
         stage.mkdir()
         try:
             yield stage
-            if not out_dir.exists():
+            try:  # one atomic step where out_dir is absent (or, on POSIX, an empty folder)
                 stage.rename(out_dir)
-            else:
+            except OSError:  # out_dir holds files: they are replaced one by one
                 for item in sorted(stage.iterdir()):
                     item.replace(out_dir / item.name)
         finally:

@@ -33,7 +33,8 @@ from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import file_sha256
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome, run_subject
 
-__all__ = ["THREAD_VARIABLES", "WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker", "cpu_count"]
+__all__ = ["THREAD_VARIABLES", "WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker",
+           "cpu_count"]
 
 logger = logging.getLogger(__name__)
 
@@ -126,7 +127,7 @@ class WorkerDeaths:
         return SubjectOutcome(job.subject_id,
                               f"its worker process died while fitting it, {self.LIMIT} times"
                               + (f" ({detail})" if detail else "") + "; a crash in native "
-                              "code or the system out of memory?", 0.0, time.time(), "")
+                              "code or the system out of memory?", 0.0, 0.0, "")
 
 
 # --- the local engine's workers ------------------------------------------------------------
@@ -194,9 +195,9 @@ class LocalEngine:
         self._context = multiprocessing.get_context("spawn")
 
     def _pool(self) -> ProcessPoolExecutor:
+        counter = self._context.Value("i", 0) if self.setup.devices else None
         return ProcessPoolExecutor(self.workers, self._context, initializer=_init_local_worker,
-                                   initargs=(self.setup, self._context.Value("i", 0),
-                                             os.getpid()))
+                                   initargs=(self.setup, counter, os.getpid()))
 
     def run(self, jobs: Iterable[SubjectJob], report: Callable[[SubjectOutcome], None]) -> None:
         """Run every job, calling ``report`` with each outcome as it comes (in the order

@@ -202,6 +202,8 @@ def read_subjects(path: Path) -> SubjectTable:
                         ", ...) and a row per subject")
     (_, header), records = records[0], records[1:]
     _check_header(path, header)
+    if not records:
+        raise UserError(f"{path} has a header but no subject rows")
     folder = path.parent.resolve()
     rows, bad_rows, first_line = [], [], {}
     id_column = header.index("id")

@@ -167,11 +167,13 @@ def test_a_subjects_results_are_those_of_fitter_run(local_batch, studio, tmp_pat
     assert batched["inputs"]["front"] == str(folder / "s1" / "front.png")  # absolute
 
 
-def test_same_seed_same_results_with_one_worker(local_batch, studio, tmp_path):
+def test_same_seed_same_results_with_one_worker_and_a_run_jsons_settings(local_batch, studio,
+                                                                         tmp_path):
     out, _, _, _ = local_batch
     folder, _ = studio
+    # --config: the settings (BUDGET's) of a subject's run.json, not its person
     code, _, stderr = batch(folder / "six.csv", "-o", tmp_path / "one", "--workers", 1,
-                            "--skip-bad-rows", *BUDGET)
+                            "--skip-bad-rows", "--config", out / "s0" / "run.json")
     assert code == 1, stderr
     assert results(tmp_path / "one") == results(out)
     assert failures(tmp_path / "one") == failures(out)
@@ -351,7 +353,8 @@ def test_bad_input_is_one_line_exit_2_before_any_work(studio, tmp_path, header, 
 def test_a_missing_or_non_utf8_table_is_one_line_exit_2(tmp_path):
     for content, message in ((None, "no such file"), (b"id,front\n\xff\xfe\x00", "UTF-8"),
                              (b"id;front;side;height_cm\n", "separated by ';'"),
-                             (b"", "is empty")):
+                             (b"", "is empty"),
+                             (b"id,front,side,height_cm\n", "no subject rows")):
         table = tmp_path / "table.csv"
         table.unlink(missing_ok=True)
         if content is not None:

@@ -43,6 +43,16 @@ def test_staged_directory_fills_an_existing_folder_and_keeps_its_other_files(tmp
     assert (tmp_path / "out" / "a.txt").read_text() == "new"
 
 
+def test_staged_directory_takes_an_empty_folders_place_in_one_step(tmp_path):
+    (tmp_path / "out").mkdir()
+    empty = (tmp_path / "out").stat().st_ino
+    with staged_directory(tmp_path / "out") as stage:
+        write_text(stage / "a.txt", "a")
+        staged = stage.stat().st_ino
+    assert (tmp_path / "out").stat().st_ino == staged != empty  # renamed, not filled
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
 def test_stage_pattern_names_the_folder_a_staging_folder_is_for(tmp_path):
     from bodyfit.fitter.outputs import STAGE_PATTERN
 
