@@ -40,7 +40,9 @@ logger = logging.getLogger(__name__)
 
 #: The environment variables that size the native thread pools of NumPy's BLAS and of
 #: OpenMP; read once when a process loads them, so they are set for the workers to
-#: inherit (a user's own values are kept).
+#: inherit (a user's own values are kept). One thread each: the fit's matrices are small,
+#: and more BLAS threads only spin (two BLAS threads made a worker 2.7 times slower on two
+#: cores, even alone).
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 #: How often a local worker checks that the batch that started it is still alive, seconds.
 _PARENT_CHECK_S = 0.5
@@ -62,7 +64,8 @@ class WorkerSetup:
         model_sha256: the driver's body model file's SHA-256; a worker that would load
             another model (another machine's cache) refuses to start, so that every
             subject is fitted with the same model.
-        threads: torch and OpenCV threads per worker (None: their defaults).
+        threads: torch and OpenCV threads per worker (None: their defaults; BLAS and
+            OpenMP get one, ``THREAD_VARIABLES``).
         log_level: the workers' logging level.
         devices: the kernels' devices the workers take in turn (worker i gets
             ``devices[i % len(devices)]``); empty: each job's own device.
@@ -137,17 +140,12 @@ _worker_device = None
 
 
 @contextlib.contextmanager
-def _thread_environment(threads: int | None):
-    """Set ``THREAD_VARIABLES`` to ``threads`` for the block (for the workers it spawns):
-    two workers on two cores, each with a BLAS thread per core, run several times slower
-    than with one each."""
-    if threads is None:
-        yield
-        return
+def _single_threaded_blas():
+    """Set ``THREAD_VARIABLES`` to 1 for the block, for the workers it spawns."""
     saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
     for name, value in saved.items():
         if value is None:
-            os.environ[name] = str(threads)
+            os.environ[name] = "1"
     try:
         yield
     finally:
@@ -208,7 +206,7 @@ class LocalEngine:
                 every subject).
         """
         queue, deaths = collections.deque(jobs), WorkerDeaths()
-        with _thread_environment(self.setup.threads):
+        with _single_threaded_blas():
             self._run(queue, deaths, report)
 
     def _run(self, queue, deaths: WorkerDeaths, report) -> None:
