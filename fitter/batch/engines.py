@@ -23,6 +23,7 @@ import dataclasses
 import logging
 import multiprocessing
 import os
+import platform
 import threading
 import time
 from collections.abc import Callable, Iterable
@@ -102,7 +103,7 @@ def start_worker(setup: WorkerSetup):
 
     path = active_model_path()
     if file_sha256(path) != setup.model_sha256:
-        raise UserError(f"the worker on {os.uname().nodename} would fit with the body model "
+        raise UserError(f"the worker on {platform.node()} would fit with the body model "
                         f"{path}, which is not the batch's; give every machine the same "
                         "model")
     return load_model()
