@@ -86,11 +86,11 @@ def _project(camera, points: np.ndarray) -> np.ndarray:
 
 def scaled_person(mask: np.ndarray, scale: float) -> np.ndarray:
     """The person's bounding box of a (H, W) bool ``mask`` resized by ``scale``: (h, w) bool,
-    area resampling cut at one half."""
+    area resampling cut at one half. The scale is exactly ``scale`` both ways (OpenCV keeps
+    ``fx``/``fy``; a size rounded per axis would stretch the person by up to half a pixel)."""
     rows, cols = np.nonzero(mask)
     crop = mask[rows.min():rows.max() + 1, cols.min():cols.max() + 1].astype(np.float32)
-    size = (max(1, round(crop.shape[1] * scale)), max(1, round(crop.shape[0] * scale)))
-    return cv2.resize(crop, size, interpolation=cv2.INTER_AREA) > 0.5
+    return cv2.resize(crop, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA) > 0.5
 
 
 def orthographic_view(name: str, mask: np.ndarray, stature_m: float, extent: np.ndarray,

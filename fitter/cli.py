@@ -103,6 +103,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "person")
     parser.add_argument("--device", help="cpu (default) or cuda:0"
                         + ("; cuda: one worker per GPU" if batch else ""))
+    parser.add_argument("--threads", type=int,
+                        help="CPU threads scoring each generation (default: one per core"
+                             + ("; fitter batch: the cores shared among the local workers"
+                                if batch else "") + "; the result does not depend on it)")
     if not batch:
         parser.add_argument("--overwrite", action="store_true",
                             help="write into a non-empty OUT")

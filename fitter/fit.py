@@ -14,6 +14,7 @@ import dataclasses
 import time
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
@@ -41,6 +42,8 @@ class FitSettings:
         cost: the kernels' weights, matching and alignment (default: the ``bodyfit``
             weights preset, symmetric matching, the vertical anchor on the extremes).
         device: where the kernels run, "cpu" or "cuda:0".
+        threads: CPU threads evaluating each population side by side (None: one per core
+            this process may use; ignored on a GPU). The result does not depend on it.
         side_arms: how the side view treats the person's arms, one of
             ``bodyfit.fitter.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
             arms hanging down; "hidden": without arms).
@@ -54,6 +57,7 @@ class FitSettings:
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="symmetric", vertical_anchor="extremes"))
     device: str = "cpu"
+    threads: int | None = None
     side_arms: str = "down"
     projection: str = "pinhole"
 
@@ -159,12 +163,16 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                          mean_body, model, settings, options[name])
              for name in ("front", "side")}
     arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
-    evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost)
+    evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost,
+                                           workers=settings.threads)
     conditioner = None
     if s.condition_stature:
         conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies)
     t1 = time.perf_counter()
-    result = search(evaluator, s, conditioner, progress)
+    # The search's matrices are tiny (CMA-ES's 24 x 24, the conditioner's): BLAS threads
+    # would only spin, on the cores the kernels' threads evaluate the population on.
+    with threadpool_limits(limits=1, user_api="blas"):
+        result = search(evaluator, s, conditioner, progress)
     t2 = time.perf_counter()
     betas = result.betas[None]
     posed = forward(model, betas, result.pose_deg[None])[0]

@@ -15,7 +15,7 @@ import numpy as np
 from bodyfit.fitter.body_model import PART_NAMES
 
 __all__ = ["PART_COLOURS_BGR", "render_parts", "orthographic_pixels", "render_pinhole",
-           "pinhole_pixels", "coverage_mask", "parts_legend"]
+           "pinhole_pixels", "coverage_mask", "centre_samples", "parts_legend"]
 
 #: One BGR colour per part, ``PART_NAMES`` order.
 PART_COLOURS_BGR = np.array([
@@ -38,7 +38,7 @@ _SUBPIXEL_BITS = 2
 
 
 def render_parts(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray,
-                 view: str, height_px: int = 600, margin_px: int = 10) -> np.ndarray:
+                 view: str, height_px: int = 600, margin_px: float = 10) -> np.ndarray:
     """Render one view of a body.
 
     Args:
@@ -46,21 +46,23 @@ def render_parts(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray
         faces: (F, 3) int triangles.
         face_parts: (F,) int part label of each face.
         view: "front" or "side".
+        height_px, margin_px: :func:`orthographic_pixels`.
 
     Returns:
         (height_px, W, 3) uint8 BGR image on white, W fitted to the body.
     """
     right, toward = _VIEWS[view]
     px = orthographic_pixels(vertices, view, height_px, margin_px)
-    width = int(np.ceil(px[:, 0].max())) + margin_px
+    width = int(np.ceil(px[:, 0].max() + margin_px))
     image = np.full((height_px, width, 3), 255, np.uint8)
     return _paint(image, px, vertices @ toward, vertices, faces, face_parts, toward)
 
 
 def orthographic_pixels(vertices: np.ndarray, view: str, height_px: int,
-                        margin_px: int) -> np.ndarray:
-    """(V, 2) float pixel coordinates of :func:`render_parts`' picture: the body scaled to
-    ``height_px - 2 margin_px`` pixels tall, ``margin_px`` from the top and the left."""
+                        margin_px: float) -> np.ndarray:
+    """(V, 2) float pixel coordinates (pixel centres at integers) of :func:`render_parts`'
+    picture: the body scaled to ``height_px - 2 margin_px`` pixels tall, ``margin_px`` from
+    the top and the left."""
     right, _ = _VIEWS[view]
     u, z = vertices @ right, vertices[:, 2]
     scale = (height_px - 2 * margin_px) / np.ptp(z)
@@ -101,17 +103,64 @@ def pinhole_pixels(vertices: np.ndarray, intrinsics: np.ndarray, rotation: np.nd
 
 
 def coverage_mask(px: np.ndarray, faces: np.ndarray, size_px: tuple[int, int],
-                  supersample: int = 4) -> np.ndarray:
-    """(H, W) bool: the pixels that triangles ``px[faces]`` ((V, 2) pixels) cover by more
-    than half, filled at ``supersample`` times the resolution and area-averaged (OpenCV's
-    polygon fill takes every pixel it touches: 1 px too wide at 1x, 1/supersample px here)."""
+                  supersample: int = 5) -> np.ndarray:
+    """(H, W) bool: the pixels that triangles ``px[faces]`` ((V, 2) pixels, pixel centres at
+    integers) cover by more than half: the union of the triangles sampled at the centres
+    of a ``supersample`` times finer grid (:func:`centre_samples`), area-averaged.
+
+    Unbiased, where two earlier versions were not (each made every synthetic fit come out
+    about 2 mm large): OpenCV's polygon fill takes every fine pixel an outline touches
+    (0.4 px too wide per row of a body at 4x), and an even ``supersample`` leaves pixels
+    covered by exactly one half, all of them dropped (0.2 px too narrow at 4x); an odd one
+    has no such ties.
+    """
+    if supersample % 2 == 0:
+        raise ValueError(f"supersample must be odd (no pixel covered by exactly one half), "
+                         f"got {supersample}")
     width, height = size_px
-    fine = np.zeros((height * supersample, width * supersample), np.uint8)
-    corners = (px[faces] + 0.5) * supersample - 0.5  # pixel centres at the finer grid's
-    polygons = np.round(corners * (1 << _SUBPIXEL_BITS)).astype(np.int32)
-    for polygon in polygons:  # one call per triangle: several polygons fill even-odd
-        cv2.fillConvexPoly(fine, polygon, 1, lineType=cv2.LINE_8, shift=_SUBPIXEL_BITS)
+    corners = (np.asarray(px, np.float64) + 0.5) * supersample - 0.5
+    fine = centre_samples(corners, faces, (width * supersample, height * supersample))
     return cv2.resize(fine.astype(np.float32), (width, height), interpolation=cv2.INTER_AREA) > 0.5
+
+
+def centre_samples(px: np.ndarray, faces: np.ndarray, size_px: tuple[int, int]) -> np.ndarray:
+    """(H, W) bool: the pixels whose centre (integer coordinates) lies inside or on an edge
+    of a triangle ``px[faces]`` ((V, 2) float pixels, either winding): the GPU's coverage
+    rule, computed on the host, triangles batched by the size of their bounding boxes."""
+    width, height = size_px
+    out = np.zeros((height, width), bool)
+    tri = np.asarray(px, np.float64)[np.asarray(faces)]  # (F, 3, 2)
+    lo = np.maximum(np.ceil(tri.min(axis=1)), 0).astype(np.int64)  # first centre (x, y)
+    hi = np.minimum(np.floor(tri.max(axis=1)), [width - 1, height - 1]).astype(np.int64)
+    span = hi - lo + 1  # (F, 2) centres across the box
+    edge1, edge2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
+    area = edge1[:, 0] * edge2[:, 1] - edge1[:, 1] * edge2[:, 0]
+    live = np.all(span > 0, axis=1) & (area != 0)
+    tri, lo, span = tri[live], lo[live], span[live]
+    tri = np.where((area[live] < 0)[:, None, None], tri[:, ::-1], tri)  # one winding
+    order = np.argsort(span[:, 0] * span[:, 1])
+    start = 0
+    while start < len(order):  # batches of similar boxes, about 2**22 samples each
+        box = span[order[start]]
+        stop = start + 1
+        while stop < len(order) and stop - start < 4096 and \
+                (stop - start + 1) * np.prod(np.maximum(box, span[order[stop]])) < 1 << 22:
+            box = np.maximum(box, span[order[stop]])
+            stop += 1
+        batch = order[start:stop]
+        xs = lo[batch, 0, None, None] + np.arange(box[0])[None, None, :]  # (T, 1, bw)
+        ys = lo[batch, 1, None, None] + np.arange(box[1])[None, :, None]  # (T, bh, 1)
+        inside = (xs < (lo[batch, 0] + span[batch, 0])[:, None, None]) \
+            & (ys < (lo[batch, 1] + span[batch, 1])[:, None, None])
+        for a, b in ((0, 1), (1, 2), (2, 0)):
+            pa, pb = tri[batch, a], tri[batch, b]  # (T, 2)
+            edge = (pb[:, 0, None, None] - pa[:, 0, None, None]) * (ys - pa[:, 1, None, None]) \
+                - (pb[:, 1, None, None] - pa[:, 1, None, None]) * (xs - pa[:, 0, None, None])
+            inside &= edge >= -1e-9
+        t, r, c = np.nonzero(inside)
+        out[lo[batch[t], 1] + r, lo[batch[t], 0] + c] = True
+        start = stop
+    return out
 
 
 def _paint(image, px, toward_depth, vertices, faces, face_parts, toward) -> np.ndarray:

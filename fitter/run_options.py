@@ -48,7 +48,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     """``base`` with every fit option of ``options`` that is not None applied: the search's
     (``SEARCH_OPTIONS``, ``free_stature``), the cost's (``matching``, ``vertical_anchor``,
     ``weights`` (a preset or a .toml file, replacing the weights) and ``weight`` (a list of
-    ``NAME=VALUE`` overrides on top)), ``device``, ``side_arms`` and ``projection``.
+    ``NAME=VALUE`` overrides on top)), ``device``, ``threads``, ``side_arms`` and
+    ``projection``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -68,5 +69,6 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
         cost = settings_from_record(record, cost)
     return dataclasses.replace(base, search=search, cost=cost,
                                device=given.get("device", base.device),
+                               threads=given.get("threads", base.threads),
                                side_arms=given.get("side_arms", base.side_arms),
                                projection=given.get("projection", base.projection))

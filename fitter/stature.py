@@ -25,13 +25,15 @@ import dataclasses
 
 import numpy as np
 
-from bodyfit.fitter.body_model import BodyModel, abduction_rotations
+from bodyfit.fitter.body_model import BodyModel, forward
 
 __all__ = ["StatureConditioner", "stature_scale"]
 
 #: Vertices within this distance (metres) of the top or bottom of any extreme body are
-#: the candidates for a body's highest and lowest points.
-_EXTREME_BAND_M = 0.06
+#: the candidates for a body's highest and lowest points (679 of 13,348 vertices; over
+#: 3,000 random bodies of the search's range, +-3 sigma and every pose, the highest and
+#: the lowest vertex were always among them; 5 mm missed 5 per cent of the lowest).
+_EXTREME_BAND_M = 0.01
 _ITERATIONS = 6
 
 
@@ -68,31 +70,9 @@ class StatureConditioner:
         bottom = z <= z.min(axis=1, keepdims=True) + _EXTREME_BAND_M
         return np.flatnonzero((top | bottom).any(axis=0))
 
-    def _posed_heights_basis(self, pose_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The posed z of the extreme vertices as an affine function of the betas.
-
-        For a fixed pose, Eq. 2 is linear in the rest vertices and joints, so
-        ``z = z0 + G @ betas`` with z0 (P, V') the mean body's and G (P, V', K) metres per
-        sigma: z = (1 - sum_c w_c) v_z + sum_c w_c (R_c v + (I - R_c) j_c)_z.
-        """
-        m = self._model
-        rz = abduction_rotations(pose_deg)[:, :, 2, :]  # (P, 4, 3): the z rows
-        joint_rz = np.eye(3)[2] - rz  # (P, 4, 3)
-        w = m.chain_weights.astype(np.float64)
-        free = 1.0 - w.sum(axis=1)
-        vertex_dirs, joint_dirs = m.shape_directions(self.num_betas)
-
-        def posed_z(vertices, joints, spec):
-            own = np.einsum(f"v,{spec[0]}->{spec[1]}", free, vertices[..., 2], optimize=True)
-            moved = np.einsum(f"vc,pcd,{spec[2]}->{spec[3]}", w, rz, vertices, optimize=True)
-            hinge = np.einsum(f"vc,pcd,{spec[4]}->{spec[5]}", w, joint_rz, joints, optimize=True)
-            return own + moved + hinge
-
-        z0 = posed_z(m.mean_vertices.astype(np.float64), m.mean_joints.astype(np.float64),
-                     ("v", "v", "vd", "pv", "cd", "pv"))
-        grad = posed_z(vertex_dirs.astype(np.float64), joint_dirs.astype(np.float64),
-                       ("kv", "vk", "kvd", "pvk", "kcd", "pvk"))
-        return z0, grad
+    def _posed_z(self, betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
+        """(P, V') float64 posed heights of the extreme vertices, metres."""
+        return forward(self._model, betas, pose_deg)[..., 2].astype(np.float64)
 
     def complete(self, other_betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
         """(P, K) float64 betas: the solved first beta, then ``other_betas``.
@@ -102,9 +82,11 @@ class StatureConditioner:
             pose_deg: (P, 4) degrees.
         """
         other_betas = np.asarray(other_betas, np.float64)
-        z0, grad = self._posed_heights_basis(np.asarray(pose_deg, np.float64))
-        base = z0 + np.einsum("pvk,pk->pv", grad[:, :, 1:], other_betas)  # (P, V')
-        slope = grad[:, :, 0]
+        # for a fixed pose the posed vertices are linear in the betas (Eq. 1-3 with the
+        # rotations fixed), so the heights are base + first beta * slope
+        zero = np.zeros((len(other_betas), 1))
+        base = self._posed_z(np.hstack([zero, other_betas]), pose_deg)  # (P, V')
+        slope = self._posed_z(np.hstack([zero + 1.0, other_betas]), pose_deg) - base
         first = np.zeros(len(other_betas))
         rows = np.arange(len(first))
         for _ in range(_ITERATIONS):

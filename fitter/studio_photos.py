@@ -49,11 +49,15 @@ def photo(vertices, model, view: str, parts, body_px: int = 700,
           size_px: tuple[int, int] = (600, 800)) -> np.ndarray:
     """(H, W, 3) uint8 BGR photo of posed ``vertices`` (V, 3) metres, one view."""
     faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
-    image = render_parts(vertices, faces, face_parts, view, body_px, margin_px=0)
+    # body_px tall from the top edge of the first row to the bottom edge of the last
+    # (with its top and bottom on pixel centres, the person would span body_px - 1 rows,
+    # and the fitter, which reads the stature's scale from the rows, would see them
+    # 1/body_px too large)
+    image = render_parts(vertices, faces, face_parts, view, body_px + 1, margin_px=0.5)
     h, w = image.shape[:2]
     # the person's pixels: those the body covers by more than half (OpenCV's polygon fill
     # of the painted picture takes every pixel it touches, a pixel too wide)
-    body = coverage_mask(orthographic_pixels(vertices, view, body_px, 0), faces, (w, h))
+    body = coverage_mask(orthographic_pixels(vertices, view, body_px + 1, 0.5), faces, (w, h))
     if view == "side":  # render_parts draws the side view mirrored
         image, body = image[:, ::-1], body[:, ::-1]
     width, height = size_px

@@ -47,6 +47,7 @@ _EXPORTS = {
     "PopulationCost": "evaluator",
     "PopulationEvaluator": "evaluator",
     "evaluate_population": "evaluator",
+    "cpu_threads": "evaluator",
 }
 
 __all__ = list(_EXPORTS)
@@ -54,7 +55,7 @@ __all__ = list(_EXPORTS)
 if TYPE_CHECKING:
     from bodyfit.kernels.body_layout import PART_NAMES, POSE_NAMES
     from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
-    from bodyfit.kernels.evaluator import (PopulationCost, PopulationEvaluator,
+    from bodyfit.kernels.evaluator import (PopulationCost, PopulationEvaluator, cpu_threads,
                                             evaluate_population)
     from bodyfit.kernels.raster import rasterize
     from bodyfit.kernels.skinning import ModelArrays, SkinnableModel, skin

@@ -31,8 +31,11 @@ def rest_shape(model, betas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if betas.ndim != 2:
         raise ValueError(f"betas must have shape (P, K), got {betas.shape}")
     vertex_dirs, joint_dirs = model.shape_directions(betas.shape[1])
-    vertices = model.mean_vertices + np.einsum("pk,kvd->pvd", betas, vertex_dirs)
-    joints = model.mean_joints + np.einsum("pk,kjd->pjd", betas, joint_dirs)
+    num = betas.shape[0]
+    vertices = model.mean_vertices + (betas @ vertex_dirs.reshape(len(vertex_dirs), -1)
+                                      ).reshape(num, *model.mean_vertices.shape)
+    joints = model.mean_joints + (betas @ joint_dirs.reshape(len(joint_dirs), -1)
+                                  ).reshape(num, *model.mean_joints.shape)
     return vertices.astype(np.float32), joints.astype(np.float32)
 
 
@@ -78,9 +81,12 @@ def forward(model, betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
         raise ValueError(f"betas must be (P, K) and pose (P, 4); got {betas.shape} "
                          f"and {pose_deg.shape}")
     rest, joints = rest_shape(model, betas)
-    rot = abduction_rotations(pose_deg)  # (P, 4, 3, 3)
-    offset = rest[:, None, :, :] - joints[:, :, None, :]  # (P, 4, V, 3)
-    moved = np.einsum("pcij,pcvj->pcvi", rot, offset) + joints[:, :, None, :]
-    delta = moved - rest[:, None, :, :]  # (P, 4, V, 3)
-    posed = rest + np.einsum("vc,pcvd->pvd", model.chain_weights, delta)
+    rot_t = abduction_rotations(pose_deg).transpose(0, 1, 3, 2)  # (P, 4, 3, 3), R^T
+    weights = model.chain_weights.astype(np.float64)  # (V, 4)
+    # posed = (1 - sum_c w_c) v + sum_c w_c (R_c (v - j_c) + j_c), rows as row vectors
+    posed = rest * (1.0 - weights.sum(axis=1))[:, None]
+    for c in range(weights.shape[1]):
+        pivot = joints[:, c, None, :]  # (P, 1, 3)
+        moved = (rest - pivot) @ rot_t[:, c] + pivot  # (P, V, 3)
+        posed += weights[:, c, None] * moved
     return posed.astype(np.float32)

@@ -65,8 +65,9 @@ class WorkerSetup:
         model_sha256: the driver's body model file's SHA-256; a worker that would load
             another model (another machine's cache) refuses to start, so that every
             subject is fitted with the same model.
-        threads: torch and OpenCV threads per worker (None: their defaults; BLAS and
-            OpenMP get one, ``THREAD_VARIABLES``).
+        threads: the worker's share of the CPU cores: the threads its fits score
+            candidates on (unless ``--threads`` says), and torch's and OpenCV's (None:
+            their defaults; BLAS and OpenMP get one, ``THREAD_VARIABLES``).
         log_level: the workers' logging level.
         devices: the kernels' devices the workers take in turn (worker i gets
             ``devices[i % len(devices)]``); empty: each job's own device.
@@ -138,6 +139,7 @@ class WorkerDeaths:
 
 _worker_model = None
 _worker_device = None
+_worker_threads = None
 
 
 @contextlib.contextmanager
@@ -164,18 +166,19 @@ def _watch_parent(parent_pid: int) -> None:
 
 
 def _init_local_worker(setup: WorkerSetup, counter, parent_pid: int) -> None:
-    global _worker_model, _worker_device
+    global _worker_model, _worker_device, _worker_threads
     threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True).start()
     if setup.devices:
         with counter.get_lock():
             index = counter.value
             counter.value += 1
         _worker_device = setup.devices[index % len(setup.devices)]
+    _worker_threads = setup.threads
     _worker_model = start_worker(setup)
 
 
 def _run_local_job(job: SubjectJob) -> SubjectOutcome:
-    return run_subject(job, _worker_model, _worker_device)
+    return run_subject(job, _worker_model, _worker_device, _worker_threads)
 
 
 def _local_worker_ready() -> int:

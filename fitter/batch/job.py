@@ -118,6 +118,8 @@ def check_settings(settings: FitSettings, model: BodyModel) -> None:
     any work, rather than once per subject)."""
     settings.search.validate(model.num_components)
     settings.canvas.validate()
+    if settings.threads is not None and settings.threads < 1:
+        raise UserError(f"--threads must be at least 1, got {settings.threads}")
     if settings.projection not in ("orthographic", "pinhole"):
         raise UserError(f"projection must be orthographic or pinhole, got "
                         f"{settings.projection!r}")
@@ -136,14 +138,17 @@ def _test_exit_hook(subject_id: str) -> None:
         os._exit(1)
 
 
-def run_subject(job: SubjectJob, model: BodyModel, device: str | None = None
-                ) -> SubjectOutcome:
+def run_subject(job: SubjectJob, model: BodyModel, device: str | None = None,
+                threads: int | None = None) -> SubjectOutcome:
     """Fit one subject into ``job.out_dir``; never raises for the subject's own problems.
 
     Args:
         model: the body model, loaded once per worker.
         device: where this worker runs the kernels (an engine's placement, e.g. the GPU it
             was given); None: ``job.settings.device``.
+        threads: the CPU threads this worker's fits score candidates on (its share of
+            the machine's cores) when the job does not say (``--threads``); None: the
+            fit's default, one per core. The result does not depend on it.
 
     Returns:
         The outcome: fitted, or the reason it failed (a bad photo, no person, any error,
@@ -152,8 +157,9 @@ def run_subject(job: SubjectJob, model: BodyModel, device: str | None = None
     started_at, start = time.time(), time.perf_counter()
     worker = f"{os.getpid()}@{platform.node()}"
     _test_exit_hook(job.subject_id)
-    settings = job.settings if device is None else dataclasses.replace(job.settings,
-                                                                       device=device)
+    settings = dataclasses.replace(
+        job.settings, device=device or job.settings.device,
+        threads=job.settings.threads if job.settings.threads is not None else threads)
     try:
         run_person(model, job.inputs, settings, job.out_dir, progress=False)
         reason = ""

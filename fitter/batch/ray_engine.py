@@ -47,17 +47,19 @@ def import_ray():
 
 
 class SubjectWorker:
-    """A Ray actor's state: the body model, loaded once, and the device it fits on."""
+    """A Ray actor's state: the body model, loaded once, the device it fits on and its
+    threads (its reserved CPUs)."""
 
     def __init__(self, setup: WorkerSetup):
         self.model = start_worker(setup)
         self.device = setup.devices[0] if setup.devices else None
+        self.threads = setup.threads
 
     def ready(self) -> bool:
         return True
 
     def run(self, job: SubjectJob) -> SubjectOutcome:
-        return run_subject(job, self.model, self.device)
+        return run_subject(job, self.model, self.device, self.threads)
 
 
 class RayEngine:

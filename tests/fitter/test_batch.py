@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 import pytest
 
+from bodyfit.fitter.batch.engines import cpu_count
 from bodyfit.fitter.batch.job import WORKER_EXIT_HOOK
 from bodyfit.fitter.batch.subjects import read_subjects
 from bodyfit.fitter.cli import main
@@ -147,6 +148,9 @@ def test_batch_fits_the_good_subjects_and_records_the_broken_ones(local_batch, s
     record = json.loads((out / "batch.json").read_text())
     assert record["engine"] == "local" and record["workers"] == 2
     assert record["subjects"]["fitted"] == 4 and record["seconds"]["start_up"] > 0
+    for name in GOOD:  # each worker's fits score candidates on its share of the cores
+        settings = json.loads((out / name / "run.json").read_text())["settings"]
+        assert settings["threads"] == max(1, cpu_count() // 2)
 
 
 def test_a_subjects_results_are_those_of_fitter_run(local_batch, studio, tmp_path):
@@ -210,7 +214,7 @@ def test_killed_batch_resumes_with_every_subject_done_exactly_once(local_batch, 
         [name, str(folder / front), str(folder / side), height]
         for name, front, side, height in subject_rows(heights)])
     out = tmp_path / "out"
-    argv = [table, "-o", out, "--workers", 1, *BUDGET]
+    argv = [table, "-o", out, "--workers", 1, "--threads", 5, *BUDGET]
     process = subprocess.Popen(
         [sys.executable, "-m", "bodyfit.fitter.cli", "-q", "batch", *map(str, argv)],
         start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -240,6 +244,9 @@ def test_killed_batch_resumes_with_every_subject_done_exactly_once(local_batch, 
     assert sorted(p.name for p in out.iterdir()) == sorted([*GOOD, *BATCH_FILES])
     reference = results(local_batch[0])
     assert results(out) == {name: reference[name] for name in GOOD}
+    # the user's --threads, not the engine's share; the results do not depend on it
+    assert all(json.loads((out / name / "run.json").read_text())["settings"]["threads"] == 5
+               for name in GOOD)
 
 
 def test_a_dying_worker_is_retried_once_then_recorded_and_the_batch_finishes(
@@ -335,6 +342,7 @@ GOOD_ROW = ["s0", "s0/front.png", "s0/side.png", "170"]
     (None, [GOOD_ROW], ["--weight", "knee=3"], "unknown"),
     (None, [GOOD_ROW], ["--cpus-per-worker", "2"], "are for --ray"),
     (None, [GOOD_ROW], ["--workers", "0"], "--workers must be at least 1"),
+    (None, [GOOD_ROW], ["--threads", "0"], "--threads must be at least 1"),
 ])
 def test_bad_input_is_one_line_exit_2_before_any_work(studio, tmp_path, header, rows,
                                                       options, message):

@@ -148,6 +148,25 @@ def test_chunks_do_not_change_the_costs(model_arrays, views, candidates):
     assert np.array_equal(whole.part_costs, chunked.part_costs)
 
 
+@pytest.mark.parametrize("workers", [2, 3])
+def test_threads_do_not_change_the_costs(model_arrays, views, candidates, workers):
+    """Slices of the population on several CPU threads (3 workers: uneven slices) give
+    the costs of one thread to the last bit, and the buffers are reused for a second,
+    smaller population."""
+    one = PopulationEvaluator(model_arrays, views, workers=1).evaluate(*candidates)
+    threaded = PopulationEvaluator(model_arrays, views, chunk_size=2, workers=workers)
+    assert threaded.workers == workers
+    for count in (len(one.costs), 3):
+        result = threaded.evaluate(*(c[:count] for c in candidates))
+        assert np.array_equal(result.costs, one.costs[:count])
+        assert np.array_equal(result.part_costs, one.part_costs[:count])
+
+
+def test_workers_must_be_positive(model_arrays, views):
+    with pytest.raises(ValueError, match="workers"):
+        PopulationEvaluator(model_arrays, views, workers=0)
+
+
 def test_profile_times_every_stage(model_arrays, views, candidates):
     evaluator = PopulationEvaluator(model_arrays, views, profile=True)
     evaluator.evaluate(*candidates)
