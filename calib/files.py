@@ -15,13 +15,14 @@ import contextlib
 import hashlib
 import json
 import os
+import re
 import secrets
 from pathlib import Path
 
 from bodyfit.calib.errors import UserError
 
-__all__ = ["read_json_file", "check_writable_dir", "created_folders", "file_sha256",
-           "write_atomic"]
+__all__ = ["TEMP_FILE_PATTERN", "read_json_file", "check_writable_dir", "created_folders",
+           "file_sha256", "write_atomic"]
 
 
 def _missing_folders(path: Path) -> list[Path]:
@@ -66,6 +67,11 @@ def created_folders(folder: str | os.PathLike):
             with contextlib.suppress(OSError):  # something else wrote into it meanwhile
                 missing.rmdir()
         raise
+
+
+#: The name of :func:`write_atomic`'s temporary file for a target named N:
+#: ``.N.{pid}.{8 hex digits}.part``, N its group 1 (a process killed mid-write leaves it).
+TEMP_FILE_PATTERN = re.compile(r"\.(.+)\.[0-9]+\.[0-9a-f]{8}\.part")
 
 
 def write_atomic(path: str | os.PathLike, payload: bytes) -> None:

@@ -1,7 +1,8 @@
 """`fitter`: fit the body model to a person's photos, measure meshes, build the model.
 
 The help says only what exists. User errors, usage errors included, print one line,
-``fitter: error: ...``, and exit with status 2.
+``fitter: error: ...``, and exit with status 2. `fitter batch` exits with status 1 when
+it ran but some subjects were not fitted (its failures.csv says why).
 """
 
 from __future__ import annotations
@@ -18,6 +19,97 @@ from bodyfit.calib.errors import UserError
 __all__ = ["main"]
 
 logger = logging.getLogger("bodyfit")
+
+
+def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
+    """`fitter run`'s options; `fitter batch` takes the same fit options for every subject
+    (its table gives each subject's photos, stature, masks and optionally camera, sex and
+    weights)."""
+    if batch:
+        parser.add_argument("--config", type=Path, metavar="run.json",
+                            help="the settings of a previous run's run.json (not its "
+                                 "person; the options given here override them)")
+    else:
+        parser.add_argument("--config", type=Path, metavar="run.json",
+                            help="repeat a previous run: its inputs and settings from its "
+                                 "run.json (the options given here override them)")
+    parser.add_argument("--method", choices=("bodyfit", "paper"),
+                        help="bodyfit (default: CMA-ES 30 x 200, stature-conditioned "
+                             "candidates, symmetric matching, bodyfit weights) or paper (the "
+                             "paper's method exactly: its GA 30 x 25, Table 2 weights, "
+                             "person-to-model matching); the options below override single "
+                             "settings")
+    if not batch:
+        parser.add_argument("--front", metavar="PHOTO", help="front photo, A-pose (required "
+                            "without --config)")
+        parser.add_argument("--side", metavar="PHOTO",
+                            help="side photo (the person's left side), arms hanging down")
+        parser.add_argument("--height-cm", type=float, metavar="CM",
+                            help="the person's stature, centimetres")
+        parser.add_argument("-o", "--output", type=Path, metavar="OUT",
+                            help="output folder (created; must be empty unless --overwrite)")
+    parser.add_argument("--camera", metavar="camera.json",
+                        help="the calibrated camera (calib capture): the photos are "
+                             "undistorted and fitted through it"
+                             + ("; for the rows without a camera" if batch else ""))
+    parser.add_argument("--projection", choices=("orthographic", "pinhole"),
+                        help="pinhole: the camera of --camera, or without it a typical phone "
+                             "camera (70 degrees across the long side); "
+                             "orthographic: the paper's, each view scaled from the stature "
+                             "(default pinhole; --method paper: orthographic)")
+    if not batch:
+        parser.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
+                            "(white person on black, of the undistorted upright photo)")
+        parser.add_argument("--mask-side", metavar="PNG", help="your own side silhouette")
+    parser.add_argument("--background-front", metavar="PHOTO",
+                        help="background plate: the front view without the person")
+    parser.add_argument("--background-side", metavar="PHOTO",
+                        help="background plate, side view")
+    parser.add_argument("--sex", choices=("female", "male", "unknown"),
+                        help="recorded with the run (default unknown)"
+                             + ("; for the rows without a sex" if batch else ""))
+    parser.add_argument("--weights", metavar="PRESET|FILE.toml",
+                        help="cost weights: bodyfit (Table 2 without the top and bottom "
+                             "terms; the default), paper (Table 2; the paper method's), "
+                             "uniform, lower-body, or a .toml file"
+                             + ("; for the rows without weights" if batch else ""))
+    parser.add_argument("--weight", action="append", metavar="NAME=VALUE",
+                        help="override one weight, e.g. waist=8 or view.side=3 (repeatable)")
+    parser.add_argument("--matching",
+                        help="boundary matching direction: symmetric (default), "
+                             "person_to_model (the paper's) or model_to_person")
+    parser.add_argument("--vertical-anchor", choices=("centroid", "extremes"),
+                        help="how candidates are shifted vertically onto the person: "
+                             "centroid (the paper's moments) or extremes (the middle of the "
+                             "top and bottom rows; the default)")
+    parser.add_argument("--side-arms", choices=("down", "hidden"),
+                        help="the side view's candidates: down (default) with their arms "
+                             "hanging down, as the side photo shows them; hidden: without "
+                             "arms (for a side photo whose arms hide within the torso)")
+    parser.add_argument("--optimizer", choices=("ga", "cmaes"),
+                        help="cmaes: CMA-ES (default); ga: the paper's genetic algorithm")
+    parser.add_argument("--population", type=int, help="candidates per generation "
+                        "(default 30)")
+    parser.add_argument("--generations", type=int,
+                        help="generations (default 200; --method paper: 25)")
+    parser.add_argument("--components", type=int,
+                        help="shape components searched (default 20, as the paper; up to "
+                             "60)")
+    parser.add_argument("--seed", type=int, help="random seed (default 0)"
+                        + ("; every subject uses it" if batch else ""))
+    parser.add_argument("--free-stature", action="store_true", default=None,
+                        help="search the first shape component like the others (the paper) "
+                             "instead of solving it so every candidate stands as tall as the "
+                             "person")
+    parser.add_argument("--device", help="cpu (default) or cuda:0"
+                        + ("; cuda: one worker per GPU" if batch else ""))
+    parser.add_argument("--threads", type=int,
+                        help="CPU threads scoring each generation (default: one per core"
+                             + ("; fitter batch: the cores shared among the local workers"
+                                if batch else "") + "; the result does not depend on it)")
+    if not batch:
+        parser.add_argument("--overwrite", action="store_true",
+                            help="write into a non-empty OUT")
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -69,72 +161,44 @@ def _build_parser() -> argparse.ArgumentParser:
                     "(arms hanging down) on a plain backdrop. Cameras: with --camera, "
                     "the calibrated pinhole camera, the person's distance solved from the "
                     "stature; without, see --projection (docs/fitter.md, Cameras).")
-    run.add_argument("--config", type=Path, metavar="run.json",
-                     help="repeat a previous run: its inputs and settings from its run.json "
-                          "(the options given here override them)")
-    run.add_argument("--method", choices=("bodyfit", "paper"),
-                     help="bodyfit (default: CMA-ES 30 x 200, stature-conditioned candidates, "
-                          "symmetric matching, bodyfit weights) or paper (the paper's method "
-                          "exactly: its GA 30 x 25, Table 2 weights, person-to-model "
-                          "matching); the options below override single settings")
-    run.add_argument("--front", metavar="PHOTO", help="front photo, A-pose (required "
-                     "without --config)")
-    run.add_argument("--side", metavar="PHOTO",
-                     help="side photo (the person's left side), arms hanging down")
-    run.add_argument("--height-cm", type=float, metavar="CM",
-                     help="the person's stature, centimetres")
-    run.add_argument("-o", "--output", type=Path, metavar="OUT",
-                     help="output folder (created; must be empty unless --overwrite)")
-    run.add_argument("--camera", metavar="camera.json",
-                     help="the calibrated camera (calib capture): the photos are undistorted "
-                          "and fitted through it")
-    run.add_argument("--projection", choices=("orthographic", "pinhole"),
-                     help="pinhole: the camera of --camera, or without it a typical phone "
-                          "camera (70 degrees across the long side); "
-                          "orthographic: the paper's, each view scaled from the stature "
-                          "(default pinhole; --method paper: orthographic)")
-    run.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
-                     "(white person on black, of the undistorted upright photo)")
-    run.add_argument("--mask-side", metavar="PNG", help="your own side silhouette")
-    run.add_argument("--background-front", metavar="PHOTO",
-                     help="background plate: the front view without the person")
-    run.add_argument("--background-side", metavar="PHOTO", help="background plate, side view")
-    run.add_argument("--sex", choices=("female", "male", "unknown"),
-                     help="recorded with the run (default unknown)")
-    run.add_argument("--weights", metavar="PRESET|FILE.toml",
-                     help="cost weights: bodyfit (Table 2 without the top and bottom "
-                          "terms; the default), paper (Table 2; the paper method's), "
-                          "uniform, lower-body, or a .toml file")
-    run.add_argument("--weight", action="append", metavar="NAME=VALUE",
-                     help="override one weight, e.g. waist=8 or view.side=3 (repeatable)")
-    run.add_argument("--matching",
-                     help="boundary matching direction: symmetric (default), "
-                          "person_to_model (the paper's) or model_to_person")
-    run.add_argument("--vertical-anchor", choices=("centroid", "extremes"),
-                     help="how candidates are shifted vertically onto the person: centroid "
-                          "(the paper's moments) or extremes (the middle of the top and "
-                          "bottom rows; the default)")
-    run.add_argument("--side-arms", choices=("down", "hidden"),
-                     help="the side view's candidates: down (default) with their arms "
-                          "hanging down, as the side photo shows them; hidden: without arms "
-                          "(for a side photo whose arms hide within the torso)")
-    run.add_argument("--optimizer", choices=("ga", "cmaes"),
-                     help="cmaes: CMA-ES (default); ga: the paper's genetic algorithm")
-    run.add_argument("--population", type=int, help="candidates per generation "
-                     "(default 30)")
-    run.add_argument("--generations", type=int,
-                     help="generations (default 200; --method paper: 25)")
-    run.add_argument("--components", type=int,
-                     help="shape components searched (default 20, as the paper; up to 60)")
-    run.add_argument("--seed", type=int, help="random seed (default 0)")
-    run.add_argument("--free-stature", action="store_true", default=None,
-                     help="search the first shape component like the others (the paper) "
-                          "instead of solving it so every candidate stands as tall as the "
-                          "person")
-    run.add_argument("--device", help="cpu (default) or cuda:0")
-    run.add_argument("--threads", type=int, help="CPU threads scoring each generation "
-                     "(default: one per core; the result does not depend on it)")
-    run.add_argument("--overwrite", action="store_true", help="write into a non-empty OUT")
+    _add_fit_options(run, batch=False)
+
+    batch = sub.add_parser(
+        "batch", help="fit every subject of a table (SUBJECTS.csv) as fitter run does, on "
+                      "local worker processes or a Ray cluster; resumable",
+        description="Fit every row of SUBJECTS.csv (columns id, front, side, height_cm; "
+                    "optional camera, mask_front, mask_side, sex, weights; relative paths "
+                    "are relative to the CSV's folder) as fitter run does, into OUT/<id>/, "
+                    "with OUT/summary.csv, OUT/failures.csv and OUT/batch.json. Subjects "
+                    "already fitted in OUT are kept; a subject that fails is recorded and "
+                    "the batch goes on. Exit status 0: every subject fitted; 1: some "
+                    "failed; 2: bad input (docs/batch.md).")
+    batch.add_argument("subjects", type=Path, metavar="SUBJECTS.csv",
+                       help="the subjects table, one row per subject")
+    batch.add_argument("-o", "--output", type=Path, metavar="OUT", required=True,
+                       help="output folder (created; a rerun into it resumes the batch)")
+    batch.add_argument("--workers", type=int, metavar="N",
+                       help="subjects fitted at once (default: one per CPU core, or per "
+                            "GPU with --device cuda; with --ray, as many as the cluster's "
+                            "resources hold)")
+    batch.add_argument("--ray", action="store_true",
+                       help="run the subjects as Ray tasks (pip install 'bodyfit[ray]'): "
+                            "on a local Ray instance, or on --ray-address's cluster")
+    batch.add_argument("--ray-address", metavar="ADDR",
+                       help="join this Ray cluster (e.g. ray://head:10001 or auto; implies "
+                            "--ray); inputs and OUT must lie on a file system every node "
+                            "sees at the same path")
+    batch.add_argument("--cpus-per-worker", type=float, metavar="C",
+                       help="with --ray: CPUs Ray reserves per worker (default 1)")
+    batch.add_argument("--gpus-per-worker", type=float, metavar="G",
+                       help="with --ray and --device cuda: GPUs per worker, a fraction when "
+                            "several fit on one GPU (default 1)")
+    batch.add_argument("--retry-failed", action="store_true",
+                       help="fit again the subjects OUT/failures.csv lists (a rerun skips "
+                            "them otherwise)")
+    batch.add_argument("--skip-bad-rows", action="store_true",
+                       help="skip the table's bad rows, each reported, instead of stopping")
+    _add_fit_options(batch, batch=True)
 
     measure = sub.add_parser("measure", help="the 16 measurements (mm) of a mesh in the "
                                              "model's topology (.obj/.ply)")
@@ -226,22 +290,13 @@ def _cmd_demo(args) -> None:
     print(f"fit the photos again by hand: fitter {shlex.join(run_argv)}")
 
 
-#: `fitter run`'s options that are fields of PersonInputs, and of SearchSettings.
-_INPUT_OPTIONS = ("front", "side", "height_cm", "camera", "mask_front", "mask_side",
-                  "background_front", "background_side", "sex")
-_SEARCH_OPTIONS = ("optimizer", "population", "generations", "components", "seed")
-
-
 def _run_settings(args):
     """(PersonInputs, FitSettings, output folder) of `fitter run`'s options: the defaults,
     or with --config the run.json's values, overridden by every option given."""
     import dataclasses
 
-    from bodyfit.fitter.fit import METHODS
     from bodyfit.fitter.person import PersonInputs
-    from bodyfit.fitter.run_config import read_run_config
-    from bodyfit.fitter.weights import (cost_settings, parse_override, settings_from_record,
-                                        weights_record)
+    from bodyfit.fitter.run_options import INPUT_OPTIONS, base_settings, fit_settings
 
     given = {k: v for k, v in vars(args).items() if v is not None}
     if args.config is None:
@@ -249,35 +304,15 @@ def _run_settings(args):
                    if k not in given] + ([] if args.output else ["-o"])
         if missing:
             raise UserError(f"fitter run needs {', '.join(missing)} (or --config run.json)")
-        inputs = PersonInputs(args.front, args.side, args.height_cm)
-        settings, output = METHODS[args.method or "bodyfit"], args.output
-    elif args.method is not None:
-        raise UserError("--method and --config cannot go together: the run.json holds the "
-                        "method's settings")
+    settings, config = base_settings(args.method, args.config)
+    if config is None:
+        inputs, output = PersonInputs(args.front, args.side, args.height_cm), args.output
     else:
-        config = read_run_config(args.config)
-        inputs, settings, output = config.inputs, config.settings, args.output or config.output
+        inputs, output = config.inputs, args.output or config.output
         if output is None:
             raise UserError(f"{args.config} records no output folder; give -o OUT")
-    inputs = dataclasses.replace(inputs, **{k: given[k] for k in _INPUT_OPTIONS if k in given})
-    search = dataclasses.replace(settings.search, **{k: given[k] for k in _SEARCH_OPTIONS
-                                                     if k in given})
-    if given.get("free_stature"):
-        search = dataclasses.replace(search, condition_stature=False)
-    cost = settings.cost
-    cost = dataclasses.replace(cost, **{k: given[k] for k in ("matching", "vertical_anchor")
-                                        if k in given})
-    if "weights" in given:
-        cost = cost_settings(given["weights"], given.get("weight", []), cost)
-    elif "weight" in given:  # on top of the method's or the recorded weights
-        record = weights_record(cost) | dict(map(parse_override, args.weight))
-        cost = settings_from_record(record, cost)
-    settings = dataclasses.replace(settings, search=search, cost=cost,
-                                   device=given.get("device", settings.device),
-                                   threads=given.get("threads", settings.threads),
-                                   side_arms=given.get("side_arms", settings.side_arms),
-                                   projection=given.get("projection", settings.projection))
-    return inputs, settings, output
+    inputs = dataclasses.replace(inputs, **{k: given[k] for k in INPUT_OPTIONS if k in given})
+    return inputs, fit_settings(settings, given), output
 
 
 def _cmd_run(args) -> None:
@@ -301,6 +336,126 @@ def _cmd_run(args) -> None:
     print("wrote:")
     for path in written:
         print(f"  {path}")
+
+
+def _batch_engine(args, model_sha256: str):
+    """The engine of `fitter batch`'s options: local processes, or Ray."""
+    import dataclasses
+
+    from bodyfit.fitter.batch.engines import LocalEngine, WorkerSetup, cpu_count
+
+    device = args.device or "cpu"
+    setup = WorkerSetup(model_sha256,
+                        log_level=logging.ERROR if args.quiet else logging.WARNING)
+    if args.ray or args.ray_address:
+        from bodyfit.fitter.batch.ray_engine import RayEngine
+
+        cpus = args.cpus_per_worker or 1.0
+        gpus = args.gpus_per_worker if args.gpus_per_worker is not None else (
+            1.0 if device.startswith("cuda") else 0.0)
+        setup = dataclasses.replace(setup, threads=max(1, int(cpus)))
+        return RayEngine(args.ray_address, args.workers, setup, cpus, gpus)
+    if args.cpus_per_worker is not None or args.gpus_per_worker is not None:
+        raise UserError("--cpus-per-worker and --gpus-per-worker are for --ray")
+    if device.startswith("cuda"):
+        import warp
+
+        warp.init()
+        count = warp.get_cuda_device_count()
+        devices = tuple(f"cuda:{i}" for i in range(count)) if device == "cuda" else (device,)
+        if count == 0 or not set(devices) <= {f"cuda:{i}" for i in range(count)}:
+            raise UserError(f"--device {device}: this machine has {count} CUDA devices")
+        setup = dataclasses.replace(setup, devices=devices)
+        workers = len(devices) if args.workers is None else args.workers  # one per GPU
+    else:
+        workers = cpu_count() if args.workers is None else args.workers  # one per core
+    return LocalEngine(workers, dataclasses.replace(setup, threads=max(1, cpu_count()
+                                                                       // max(1, workers))))
+
+
+def _batch_jobs(args):
+    """(the subjects table, id -> job) of `fitter batch`'s options; every problem of the
+    options or the table is a UserError here, before any work."""
+    import dataclasses
+
+    from bodyfit.calib.camera import load_camera
+    from bodyfit.fitter.batch.job import check_settings, subject_job
+    from bodyfit.fitter.batch.subjects import BadRow, read_subjects
+    from bodyfit.fitter.model_cache import load_model
+    from bodyfit.fitter.run_options import base_settings, fit_settings
+
+    options = dict(vars(args))
+    for name in ("camera", "background_front", "background_side", "weights"):
+        value = options[name]
+        if value is None or (name == "weights" and not value.endswith(".toml")):
+            continue
+        if not Path(value).is_file():
+            raise UserError(f"--{name.replace('_', '-')} {value}: no such file")
+        options[name] = str(Path(value).absolute())
+    if options["camera"]:
+        load_camera(options["camera"])
+    table = read_subjects(args.subjects)
+    base, _ = base_settings(args.method, args.config)
+    try:
+        check_settings(fit_settings(base, options), load_model())
+    except ValueError as exc:  # --matching
+        raise UserError(str(exc)) from None
+    jobs, bad_rows = {}, list(table.bad_rows)
+    for row in table.rows:
+        try:
+            jobs[row.subject_id] = subject_job(row, base, options, args.output.absolute())
+        except UserError as exc:  # the row's weights file
+            bad_rows.append(BadRow(row.line, row.subject_id, str(exc)))
+    table = dataclasses.replace(table, rows=[row for row in table.rows
+                                             if row.subject_id in jobs],
+                                bad_rows=sorted(bad_rows, key=lambda bad: bad.line))
+    if table.bad_rows and not args.skip_bad_rows:
+        more = len(table.bad_rows) - 1
+        raise UserError(table.bad_rows[0].message(args.subjects)
+                        + (f" (and {more} more bad row{'s' * (more > 1)})" if more else "")
+                        + "; fix the table, or pass --skip-bad-rows to skip bad rows")
+    return table, jobs
+
+
+def _cmd_batch(args) -> int:
+    import signal
+
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    from bodyfit.calib.files import check_writable_dir, file_sha256
+    from bodyfit.fitter.batch.orchestration import run_batch
+    from bodyfit.fitter.batch.tables import STATUSES
+    from bodyfit.fitter.model_cache import active_model_path
+
+    check_writable_dir(args.output)
+    if args.output.exists() and not args.output.is_dir():
+        raise UserError(f"output folder {args.output} is a file")
+    table, jobs = _batch_jobs(args)
+    engine = _batch_engine(args, file_sha256(active_model_path()))
+    for bad in table.bad_rows:  # every check passed: the work starts
+        print(f"fitter batch: skipping {bad.message(args.subjects)}", file=sys.stderr)
+
+    def stop(signum, frame):  # `kill` (a scheduler's time limit) stops as Ctrl-C does
+        raise KeyboardInterrupt
+
+    previous_handler = signal.signal(signal.SIGTERM, stop)
+    try:
+        with logging_redirect_tqdm():
+            result = run_batch(table, jobs, args.output, engine, args.retry_failed,
+                               progress=None if not args.quiet else False,
+                               command=["fitter", *args.argv])
+    finally:
+        signal.signal(signal.SIGTERM, previous_handler)
+    counts = {status: result.count(status) for status in STATUSES}
+    workers = f", {engine.workers} workers" if engine.workers else ""
+    print(f"fitter batch: {len(result.rows)} subjects in {result.seconds:.1f} s "
+          f"({engine.name}{workers}): "
+          + ", ".join(f"{n} {status}" for status, n in counts.items() if n))
+    print("wrote:")
+    for path in result.written:
+        print(f"  {path}")
+    # 0 when every subject of the table is fitted; failures are in failures.csv
+    return 0 if counts["fitted"] + counts["fitted earlier"] == len(result.rows) else 1
 
 
 def _cmd_measure(args) -> None:
@@ -328,6 +483,7 @@ def main(argv: list[str] | None = None) -> int:
         args = _build_parser().parse_args(argv)
     except SystemExit as stop:  # --help, --version, usage errors: argparse has printed
         return int(stop.code or 0)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # recorded by fitter batch
     logging.basicConfig(level=logging.ERROR if args.quiet else logging.INFO,
                         format="%(message)s")
     for chatty in ("anny", "bodyfit.calib"):  # their steps are logged for `calib -v`
@@ -335,18 +491,19 @@ def main(argv: list[str] | None = None) -> int:
     import warp  # Warp prints its banner and module loads at INFO; the CLI keeps to errors
 
     warp.config.log_level = warp.LOG_ERROR
-    command = {"demo": _cmd_demo, "measure": _cmd_measure, "run": _cmd_run}.get(args.command)
+    command = {"batch": _cmd_batch, "demo": _cmd_demo, "measure": _cmd_measure,
+               "run": _cmd_run}.get(args.command)
     if args.command == "model":
         command = {"build": _cmd_model_build, "info": _cmd_model_info}[args.model_command]
     try:
-        command(args)
+        code = command(args)
     except UserError as exc:
         print(f"fitter: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("fitter: interrupted", file=sys.stderr)
         return 130
-    return 0
+    return code or 0
 
 
 if __name__ == "__main__":

@@ -10,31 +10,46 @@ import contextlib
 import csv
 import io
 import json
+import re
+import secrets
 import shutil
-import tempfile
 from pathlib import Path
 
 from bodyfit.calib.files import created_folders, write_atomic
 from bodyfit.fitter.measurements import MEASUREMENTS
 
-__all__ = ["staged_directory", "write_text", "write_json", "write_measurements",
-           "write_fitted_measurements"]
+__all__ = ["STAGE_PATTERN", "staged_directory", "write_text", "write_json",
+           "write_measurements", "write_fitted_measurements"]
+
+
+#: The name of a staging directory beside OUT: ``.{OUT's name}.{8 hex digits}.partial``,
+#: OUT's name its group 1 (a ``fitter batch`` rerun removes those a killed run left).
+STAGE_PATTERN = re.compile(r"\.(.+)\.[0-9a-f]{8}\.partial")
 
 
 @contextlib.contextmanager
 def staged_directory(out_dir: Path):
-    """Yield a fresh staging directory beside ``out_dir``; on success move its files into
-    ``out_dir`` (created if needed), on any error delete it, so ``out_dir`` never holds the
-    files of a failed run."""
+    """Yield a fresh staging directory beside ``out_dir``; on success move it into place,
+    on any error delete it, so ``out_dir`` never holds the files of a failed run.
+
+    When ``out_dir`` does not exist yet (or, on POSIX, is an empty folder) the staging
+    directory is renamed to it, one atomic step: a process killed at any moment leaves
+    ``out_dir`` complete or absent (and at worst a staging directory, named as
+    ``STAGE_PATTERN`` says). Otherwise its files are moved into ``out_dir`` one by one.
+    """
     out_dir = Path(out_dir)
     with created_folders(out_dir.parent):  # the same folder rule as every single file
-        stage = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.", suffix=".partial",
-                                      dir=out_dir.parent))
+        # mkdir rather than mkdtemp: the folder gets the umask's permissions, not 0700,
+        # as it becomes out_dir itself
+        stage = out_dir.parent / f".{out_dir.name}.{secrets.token_hex(4)}.partial"
+        stage.mkdir()
         try:
             yield stage
-            out_dir.mkdir(exist_ok=True)
-            for item in sorted(stage.iterdir()):
-                item.replace(out_dir / item.name)
+            try:  # one atomic step where out_dir is absent (or, on POSIX, an empty folder)
+                stage.rename(out_dir)
+            except OSError:  # out_dir holds files: they are replaced one by one
+                for item in sorted(stage.iterdir()):
+                    item.replace(out_dir / item.name)
         finally:
             shutil.rmtree(stage, ignore_errors=True)
 

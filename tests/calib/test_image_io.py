@@ -124,3 +124,14 @@ def test_created_folders_removes_what_it_made_when_the_block_fails(tmp_path):
     with created_folders(tmp_path / "kept"):
         pass
     assert (tmp_path / "kept").is_dir()
+
+
+def test_temp_file_pattern_names_write_atomics_temporary_files(tmp_path, monkeypatch):
+    from bodyfit.calib import files
+
+    seen = []
+    real_replace = files.os.replace
+    monkeypatch.setattr(files.os, "replace",
+                        lambda source, target: (seen.append(source), real_replace(source, target)))
+    write_atomic(tmp_path / "summary.csv", b"x")
+    assert files.TEMP_FILE_PATTERN.fullmatch(seen[0].name).group(1) == "summary.csv"
