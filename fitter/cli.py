@@ -91,7 +91,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     parser.add_argument("--population", type=int, help="candidates per generation "
                         "(default 30)")
     parser.add_argument("--generations", type=int,
-                        help="generations (default 200; --method paper: 25)")
+                        help="generations (default 150; --method paper: 25)")
     parser.add_argument("--components", type=int,
                         help="shape components searched (default 20, as the paper; up to "
                              "60)")

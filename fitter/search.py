@@ -39,6 +39,9 @@ class SearchSettings:
         pose_lower_deg, pose_upper_deg: bounds of the four abduction angles, degrees
             (the paper: 0-30; people also hold their limbs a little closer than the
             model's A-pose, hence -10 by default).
+        sigma0: CMA-ES's initial step, a fraction of every gene's range (0.1: 0.6 sd of
+            a beta, 4 degrees of an angle; chosen by measured error, docs/fitter.md);
+            the GA has none.
         seed: the optimiser's random seed; the same seed gives the same search.
         condition_stature: solve each candidate's first beta so that it stands as tall as
             the person (:mod:`bodyfit.fitter.stature`) instead of searching it (the paper
@@ -47,11 +50,12 @@ class SearchSettings:
 
     optimizer: str = "cmaes"
     population: int | None = 30
-    generations: int | None = 200
+    generations: int | None = 150
     components: int = 20
     beta_limit: float = 3.0
     pose_lower_deg: tuple[float, ...] = (-10.0,) * len(POSE_NAMES)
     pose_upper_deg: tuple[float, ...] = (30.0,) * len(POSE_NAMES)
+    sigma0: float = 0.1
     seed: int = 0
     condition_stature: bool = True
 
@@ -68,6 +72,9 @@ class SearchSettings:
                 raise UserError(f"{name} must be at least {least}, got {value}")
         if not all(lo < hi for lo, hi in zip(self.pose_lower_deg, self.pose_upper_deg)):
             raise UserError("every pose lower bound must lie below its upper bound")
+        if not 0 < self.sigma0 <= 1:
+            raise UserError(f"sigma0 must be in (0, 1], a fraction of each gene's range, "
+                            f"got {self.sigma0}")
 
     @property
     def searched_betas(self) -> int:
@@ -138,9 +145,11 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
             return genes[:, :k]
         return conditioner.complete(genes[:, :k], genes[:, k:])
 
-    budget = {} if settings.generations is None else {"generations": settings.generations}
+    options = {} if settings.generations is None else {"generations": settings.generations}
+    if settings.optimizer == "cmaes":
+        options["sigma0"] = settings.sigma0
     optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
-                               population=settings.population, seed=settings.seed, **budget)
+                               population=settings.population, seed=settings.seed, **options)
     start = time.perf_counter()
     best_costs, mean_costs = [], []
     with tqdm(desc=f"search ({settings.optimizer})", unit="gen", dynamic_ncols=True,

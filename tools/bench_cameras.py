@@ -35,7 +35,7 @@ SIZE_PX = (1500, 2000)
 #: principal point 12 px right of and 18 px above the centre.
 TRUE_HFOV_DEG = 66.0
 TRUE_CENTRE_OFFSET_PX = (12.0, -18.0)
-BUDGET = ["--optimizer", "cmaes", "--population", "30", "--generations", "100"]
+BUDGET = ["--optimizer", "cmaes", "--population", "30", "--generations", "150"]
 #: name -> `fitter run` options (``{camera}``: the subject's camera.json).
 SETTINGS = {
     "(a) orthographic, no camera (the paper's)": ["--projection", "orthographic"],

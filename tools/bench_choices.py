@@ -1,6 +1,6 @@
 """Ablations of `fitter run`'s defaults: each row changes one choice, same subjects, seeds.
 
-    python tools/bench_choices.py                       # 4 subjects, CMA-ES 30 x 100
+    python tools/bench_choices.py                       # 4 subjects, CMA-ES 30 x 150
     python tools/bench_choices.py --subjects 6 --generations 200
 
 In-space subjects as tools/bench_fitter.py draws them (studio photos, the side with the
@@ -49,6 +49,9 @@ def _variants(base: FitSettings) -> dict[str, FitSettings]:
             base, cost=cost_settings("paper", (), base.cost)),
         "stature searched": replace(
             base, search=replace(base.search, condition_stature=False)),
+        "CMA-ES initial step 0.25 (before)": replace(
+            base, search=replace(base.search, sigma0=0.25)),
+        "CMA-ES initial step 0.15": replace(base, search=replace(base.search, sigma0=0.15)),
     }
 
 
@@ -69,7 +72,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--subjects", type=int, default=4)
     parser.add_argument("--seed", type=int, default=7)
-    parser.add_argument("--generations", type=int, default=100)
+    parser.add_argument("--generations", type=int, default=150)
     args = parser.parse_args()
     model = load_model()
     base = FitSettings()

@@ -38,7 +38,8 @@ SETTINGS = {
     "paper: GA 30 x 200": ["--method", "paper", "--generations", "200"],
     "bodyfit: CMA-ES 30 x 50": ["--generations", "50"],
     "bodyfit: CMA-ES 30 x 100": ["--generations", "100"],
-    "bodyfit (default): CMA-ES 30 x 200": [],
+    "bodyfit (default): CMA-ES 30 x 150": [],
+    "bodyfit: CMA-ES 30 x 200": ["--generations", "200"],
     "bodyfit: CMA-ES 30 x 400": ["--generations", "400"],
 }
 #: The studio photos are orthographic: every setting fits them so (the paper's method
@@ -52,7 +53,7 @@ CURVES = {"paper's method (GA)": [name for name in SETTINGS if name.startswith("
 def _candidates(options: list[str]) -> int:
     paper = "paper" in options
     generations = int(options[options.index("--generations") + 1]) \
-        if "--generations" in options else (25 if paper else 200)
+        if "--generations" in options else (25 if paper else 150)
     return 30 * generations
 
 

@@ -55,7 +55,7 @@ def main() -> None:
     parser.add_argument("--subjects", type=int, default=4)
     parser.add_argument("--seed", type=int, default=7, help="subjects' seed")
     parser.add_argument("--population", type=int, default=30)
-    parser.add_argument("--generations", type=int, default=100)
+    parser.add_argument("--generations", type=int, default=150)
     parser.add_argument("--search-seed", type=int, default=0)
     args = parser.parse_args()
     model = load_model()
