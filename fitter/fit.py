@@ -21,6 +21,7 @@ from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view
+from bodyfit.fitter.render_mesh import render_model
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, stature_scale
@@ -44,6 +45,8 @@ class FitSettings:
         device: where the kernels run, "cpu" or "cuda:0".
         threads: CPU threads evaluating each population side by side (None: one per core
             this process may use; ignored on a GPU). The result does not depend on it.
+        render_cell_mm: the candidates are rendered with head, hands and feet clustered
+            to cubes of this size (:mod:`bodyfit.fitter.render_mesh`; 0: the full mesh).
         side_arms: how the side view treats the person's arms, one of
             ``bodyfit.fitter.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
             arms hanging down; "hidden": without arms).
@@ -58,6 +61,7 @@ class FitSettings:
         "bodyfit", base=kernels.CostSettings(matching="symmetric", vertical_anchor="extremes"))
     device: str = "cpu"
     threads: int | None = None
+    render_cell_mm: float = 8.0
     side_arms: str = "down"
     projection: str = "pinhole"
 
@@ -70,7 +74,8 @@ METHODS = {
     "bodyfit": FitSettings(),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False),
-                         cost=kernels.CostSettings(), projection="orthographic"),
+                         cost=kernels.CostSettings(), projection="orthographic",
+                         render_cell_mm=0.0),
 }
 
 
@@ -162,7 +167,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     views = {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m, extent,
                          mean_body, model, settings, options[name])
              for name in ("front", "side")}
-    arrays = kernels.ModelArrays.from_body_model(model, s.components, settings.device)
+    arrays = kernels.ModelArrays.from_body_model(render_model(model, settings.render_cell_mm),
+                                                 s.components, settings.device)
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost,
                                            workers=settings.threads)
     conditioner = None

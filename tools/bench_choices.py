@@ -52,6 +52,7 @@ def _variants(base: FitSettings) -> dict[str, FitSettings]:
         "CMA-ES initial step 0.25 (before)": replace(
             base, search=replace(base.search, sigma0=0.25)),
         "CMA-ES initial step 0.15": replace(base, search=replace(base.search, sigma0=0.15)),
+        "full render mesh (no clustering)": replace(base, render_cell_mm=0.0),
     }
 
 
