@@ -80,8 +80,20 @@ def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label:
         if x_values is not None or len(points) == 1:
             for point in points:
                 cv2.circle(image, tuple(int(c) for c in point), 4, colour, cv2.FILLED)
-        cv2.putText(image, name, (width - right - 260, top + 22 + 20 * index), _FONT, 0.5,
-                    colour, 1, cv2.LINE_AA)
+    # the legend goes into the plot's corner that the lines cross least
+    rows = 20 * len(values)
+    corners = [(width - right - 260, top + 22), (width - right - 260, height - bottom - rows),
+               (left + 10, top + 22), (left + 10, height - bottom - rows)]
+    ink = image.min(axis=2) < 200  # lines and points, not the light grid
+
+    def crossed(corner):
+        x, y = corner
+        return int(ink[max(y - 25, 0):y + rows, max(x - 10, 0):x + 260].sum())
+
+    x, y = min(corners, key=crossed)  # the first of the least crossed
+    for index, name in enumerate(values):
+        cv2.putText(image, name, (x, y + 20 * index), _FONT, 0.5,
+                    _COLOURS_BGR[index % len(_COLOURS_BGR)], 1, cv2.LINE_AA)
     title_width = cv2.getTextSize(title, _FONT, 0.6, 1)[0][0]
     cv2.putText(image, title, ((width - title_width) // 2, 22), _FONT, 0.6, (0, 0, 0), 1,
                 cv2.LINE_AA)
