@@ -379,7 +379,7 @@ def _batch_jobs(args):
     import dataclasses
 
     from bodyfit.calib.camera import load_camera
-    from bodyfit.fitter.batch.job import check_settings, subject_job
+    from bodyfit.fitter.batch.job import subject_job
     from bodyfit.fitter.batch.subjects import BadRow, read_subjects
     from bodyfit.fitter.model_cache import load_model
     from bodyfit.fitter.run_options import base_settings, fit_settings
@@ -397,7 +397,7 @@ def _batch_jobs(args):
     table = read_subjects(args.subjects)
     base, _ = base_settings(args.method, args.config)
     try:
-        check_settings(fit_settings(base, options), load_model())
+        fit_settings(base, options).validate(load_model().num_components)
     except ValueError as exc:  # --matching
         raise UserError(str(exc)) from None
     jobs, bad_rows = {}, list(table.bad_rows)

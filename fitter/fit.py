@@ -17,6 +17,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from bodyfit import kernels
+from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
@@ -64,6 +65,19 @@ class FitSettings:
     render_cell_mm: float = 8.0
     side_arms: str = "down"
     projection: str = "pinhole"
+
+    def validate(self, stored_components: int) -> None:
+        """Raise UserError for settings no person could be fitted with (one line, naming
+        the option)."""
+        self.search.validate(stored_components)
+        self.canvas.validate()
+        if self.threads is not None and self.threads < 1:
+            raise UserError(f"--threads must be at least 1, got {self.threads}")
+        if self.render_cell_mm < 0:
+            raise UserError(f"render_cell_mm must be >= 0, got {self.render_cell_mm}")
+        if self.projection not in ("orthographic", "pinhole"):
+            raise UserError(f"--projection must be orthographic or pinhole, got "
+                            f"{self.projection!r}")
 
 
 #: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
@@ -149,13 +163,10 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
             are of; needed by the pinhole projection
             (:func:`bodyfit.fitter.person.view_intrinsics`).
     """
-    if settings.projection not in ("orthographic", "pinhole"):
-        raise ValueError(f"projection must be orthographic or pinhole, got {settings.projection!r}")
+    settings.validate(model.num_components)
     if settings.projection == "pinhole" and intrinsics is None:
         raise ValueError("the pinhole projection needs the photos' intrinsics")
     s = settings.search
-    s.validate(model.num_components)
-    settings.canvas.validate()
     t0 = time.perf_counter()
     bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
                             settings.canvas.beta_limit)

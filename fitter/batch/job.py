@@ -29,7 +29,7 @@ from bodyfit.fitter.run_options import fit_settings
 from bodyfit.fitter.batch.subjects import SubjectRow
 
 __all__ = ["SubjectJob", "SubjectOutcome", "WORKER_EXIT_HOOK", "subject_job", "run_subject",
-           "check_settings", "one_line"]
+           "one_line"]
 
 logger = logging.getLogger(__name__)
 
@@ -111,18 +111,6 @@ def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object
         options = {**options, "weights": row.weights}
     return SubjectJob(row.subject_id, inputs, fit_settings(base, options),
                       Path(out_dir) / row.subject_id)
-
-
-def check_settings(settings: FitSettings, model: BodyModel) -> None:
-    """Raise UserError for settings no subject could be fitted with (checked once, before
-    any work, rather than once per subject)."""
-    settings.search.validate(model.num_components)
-    settings.canvas.validate()
-    if settings.threads is not None and settings.threads < 1:
-        raise UserError(f"--threads must be at least 1, got {settings.threads}")
-    if settings.projection not in ("orthographic", "pinhole"):
-        raise UserError(f"projection must be orthographic or pinhole, got "
-                        f"{settings.projection!r}")
 
 
 def _test_exit_hook(subject_id: str) -> None:

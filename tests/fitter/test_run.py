@@ -107,6 +107,7 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--components": "99"}, "components"),
     ({"--matching": "both"}, "matching"),
     ({"--side-arms": "up"}, "invalid choice"),
+    ({"--threads": "0"}, "--threads"),
     ({"swap": True}, "swapped"),
     ({"blank": True}, "no person"),
 ])
