@@ -342,7 +342,8 @@ def _batch_engine(args, model_sha256: str):
     """The engine of `fitter batch`'s options: local processes, or Ray."""
     import dataclasses
 
-    from bodyfit.fitter.batch.engines import LocalEngine, WorkerSetup, cpu_count
+    from bodyfit.fitter.batch.engines import LocalEngine, WorkerSetup
+    from bodyfit.kernels import cpu_threads
 
     device = args.device or "cpu"
     setup = WorkerSetup(model_sha256,
@@ -368,9 +369,9 @@ def _batch_engine(args, model_sha256: str):
         setup = dataclasses.replace(setup, devices=devices)
         workers = len(devices) if args.workers is None else args.workers  # one per GPU
     else:
-        workers = cpu_count() if args.workers is None else args.workers  # one per core
-    return LocalEngine(workers, dataclasses.replace(setup, threads=max(1, cpu_count()
-                                                                       // max(1, workers))))
+        workers = cpu_threads() if args.workers is None else args.workers  # one per core
+    threads = max(1, cpu_threads() // max(1, workers))  # each worker's share of the cores
+    return LocalEngine(workers, dataclasses.replace(setup, threads=threads))
 
 
 def _batch_jobs(args):

@@ -34,8 +34,7 @@ from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import file_sha256
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome, run_subject
 
-__all__ = ["THREAD_VARIABLES", "WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker",
-           "cpu_count"]
+__all__ = ["THREAD_VARIABLES", "WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker"]
 
 logger = logging.getLogger(__name__)
 
@@ -47,14 +46,6 @@ logger = logging.getLogger(__name__)
 THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 #: How often a local worker checks that the batch that started it is still alive, seconds.
 _PARENT_CHECK_S = 0.5
-
-
-def cpu_count() -> int:
-    """The CPU cores this process may use."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not Linux
-        return os.cpu_count() or 1
 
 
 @dataclasses.dataclass(frozen=True)

@@ -17,7 +17,7 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.fitter.batch.engines import cpu_count
+from bodyfit.kernels import cpu_threads
 from bodyfit.fitter.batch.job import WORKER_EXIT_HOOK
 from bodyfit.fitter.batch.subjects import read_subjects
 from bodyfit.fitter.cli import main
@@ -150,7 +150,7 @@ def test_batch_fits_the_good_subjects_and_records_the_broken_ones(local_batch, s
     assert record["subjects"]["fitted"] == 4 and record["seconds"]["start_up"] > 0
     for name in GOOD:  # each worker's fits score candidates on its share of the cores
         settings = json.loads((out / name / "run.json").read_text())["settings"]
-        assert settings["threads"] == max(1, cpu_count() // 2)
+        assert settings["threads"] == max(1, cpu_threads() // 2)
 
 
 def test_a_subjects_results_are_those_of_fitter_run(local_batch, studio, tmp_path):
