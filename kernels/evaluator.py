@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import time
+import weakref
 from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple, Sequence
 
@@ -188,6 +189,7 @@ class PopulationEvaluator:
             self._pose_groups.setdefault(view.fixed_pose_deg, []).append(
                 _ViewData(view, model, settings))
         self._workspaces: list[_Workspace] = []
+        self._pool: ThreadPoolExecutor | None = None  # started by the first threaded call
         self._timer = time.perf_counter if model.device.is_cuda else time.process_time
         self._clock = 0.0
         if self.workers > 1:  # Warp's module loading is not for concurrent threads
@@ -241,9 +243,11 @@ class PopulationEvaluator:
         if workers == 1:
             evaluate_slice(*slices[0])
         else:
-            with ThreadPoolExecutor(workers) as pool:
-                for done in [pool.submit(evaluate_slice, *s) for s in slices]:
-                    done.result()
+            if self._pool is None:  # its idle threads end with the evaluator
+                self._pool = ThreadPoolExecutor(self.workers, "bodyfit-evaluator")
+                weakref.finalize(self, self._pool.shutdown, wait=False)
+            for done in [self._pool.submit(evaluate_slice, *s) for s in slices]:
+                done.result()
         return PopulationCost(costs, part_costs)
 
     def _evaluate_chunk(self, space: _Workspace, betas: wp.array, pose_deg: wp.array):
