@@ -138,28 +138,22 @@ def centre_samples(px: np.ndarray, faces: np.ndarray, size_px: tuple[int, int]) 
     live = np.all(span > 0, axis=1) & (area != 0)
     tri, lo, span = tri[live], lo[live], span[live]
     tri = np.where((area[live] < 0)[:, None, None], tri[:, ::-1], tri)  # one winding
-    order = np.argsort(span[:, 0] * span[:, 1])
-    start = 0
-    while start < len(order):  # batches of similar boxes, about 2**22 samples each
-        box = span[order[start]]
-        stop = start + 1
-        while stop < len(order) and stop - start < 4096 and \
-                (stop - start + 1) * np.prod(np.maximum(box, span[order[stop]])) < 1 << 22:
-            box = np.maximum(box, span[order[stop]])
-            stop += 1
-        batch = order[start:stop]
-        xs = lo[batch, 0, None, None] + np.arange(box[0])[None, None, :]  # (T, 1, bw)
-        ys = lo[batch, 1, None, None] + np.arange(box[1])[None, :, None]  # (T, bh, 1)
-        inside = (xs < (lo[batch, 0] + span[batch, 0])[:, None, None]) \
-            & (ys < (lo[batch, 1] + span[batch, 1])[:, None, None])
-        for a, b in ((0, 1), (1, 2), (2, 0)):
-            pa, pb = tri[batch, a], tri[batch, b]  # (T, 2)
-            edge = (pb[:, 0, None, None] - pa[:, 0, None, None]) * (ys - pa[:, 1, None, None]) \
-                - (pb[:, 1, None, None] - pa[:, 1, None, None]) * (xs - pa[:, 0, None, None])
-            inside &= edge >= -1e-9
-        t, r, c = np.nonzero(inside)
-        out[lo[batch[t], 1] + r, lo[batch[t], 0] + c] = True
-        start = stop
+    # batches: triangles whose boxes round up to the same powers of two, about 2**22
+    # samples at a time
+    bucket = 2 ** np.ceil(np.log2(span)).astype(np.int64)  # (F, 2)
+    for box in np.unique(bucket, axis=0):
+        members = np.flatnonzero(np.all(bucket == box, axis=1))
+        for batch in np.array_split(members, -(-len(members) * int(np.prod(box)) // (1 << 22))):
+            xs = lo[batch, 0, None, None] + np.arange(box[0])[None, None, :]  # (T, 1, bw)
+            ys = lo[batch, 1, None, None] + np.arange(box[1])[None, :, None]  # (T, bh, 1)
+            inside = (xs < (lo[batch, 0] + span[batch, 0])[:, None, None]) \
+                & (ys < (lo[batch, 1] + span[batch, 1])[:, None, None])
+            for a, b in ((0, 1), (1, 2), (2, 0)):
+                pa, pb = tri[batch, a, :, None, None], tri[batch, b, :, None, None]
+                inside &= (pb[:, 0] - pa[:, 0]) * (ys - pa[:, 1]) \
+                    - (pb[:, 1] - pa[:, 1]) * (xs - pa[:, 0]) >= -1e-9
+            t, r, c = np.nonzero(inside)
+            out[lo[batch[t], 1] + r, lo[batch[t], 0] + c] = True
     return out
 
 
