@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
+from bodyfit.fitter.measurements import IMPORTANT
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.studio_photos import write_pinhole_subject
-from bench_subjects import draw_subject, fit_by_command
+from bench_subjects import ERROR_HEADER, draw_subject, error_cells, fit_each_setting
 
 SIZE_PX = (1500, 2000)
 #: The true camera: a 28 mm-equivalent phone camera (66 degrees across the long side),
@@ -70,26 +70,15 @@ def main() -> None:
             scenes.append(f"{distance:.2f} m / {height:.2f} m")
             truth = write_pinhole_subject(folder, model, betas, pose, true_intrinsics(), SIZE_PX,
                                           distance, height)
-            for name, options in SETTINGS.items():
-                out = folder / f"out{list(SETTINGS).index(name)}"
-                options = [o.format(camera=folder / "camera.json") for o in options]
-                wall, error = fit_by_command(folder, truth, out, [*BUDGET, *options])
-                seconds[name].append(wall)
-                errors[name].append(error)
-    keys = list(MEASUREMENTS)
-    important = [keys.index(k) for k in IMPORTANT]
+            fit_each_setting(folder, truth, SETTINGS, BUDGET, errors, seconds)
     print(f"`python tools/bench_cameras.py --subjects {args.subjects} --seed {args.seed}` on "
           f"{time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
           f"`fitter run {' '.join(BUDGET)}` on the CPU, start-up included; camera distance / "
           f"height per subject: {', '.join(scenes)}.\n")
-    print("| camera handling | wall s (mean) | 7 important, mean abs. error (mm) | "
-          + " | ".join(IMPORTANT) + " | O |")
+    print(f"| camera handling | wall s (mean) | {ERROR_HEADER} |")
     print("|---|---|---|" + "---|" * (len(IMPORTANT) + 1))
     for name in SETTINGS:
-        err = np.abs(np.array(errors[name]))
-        print(f"| {name} | {np.mean(seconds[name]):.1f} | {err[:, important].mean():.1f} | "
-              + " | ".join(f"{err[:, i].mean():.1f}" for i in important)
-              + f" | {err[:, keys.index('O')].mean():.1f} |")
+        print(f"| {name} | {np.mean(seconds[name]):.1f} | {error_cells(errors[name])} |")
     sys.stdout.flush()
 
 

@@ -29,7 +29,7 @@ from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.studio_photos import write_subject
-from bench_subjects import draw_subject, fit_by_command
+from bench_subjects import ERROR_HEADER, draw_subject, error_cells, fit_each_setting
 
 #: name -> `fitter run` options: the paper's method and bodyfit's defaults at several
 #: budgets (candidates = population x generations), for error against time.
@@ -73,25 +73,17 @@ def main() -> None:
             folder = Path(scratch) / f"s{i}"
             folder.mkdir()
             truth = write_subject(folder, model, *draw_subject(rng))
-            for name, options in SETTINGS.items():
-                out = folder / f"out{list(SETTINGS).index(name)}"
-                wall, error = fit_by_command(folder, truth, out, [*PHOTO_OPTIONS, *options])
-                seconds[name].append(wall)
-                errors[name].append(error)
+            fit_each_setting(folder, truth, SETTINGS, PHOTO_OPTIONS, errors, seconds)
     keys = list(MEASUREMENTS)
     important = [keys.index(k) for k in IMPORTANT]
     print(f"`python tools/bench_fitter.py --subjects {args.subjects} --seed {args.seed}` on "
           f"{time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
           f"`fitter run` on the CPU, start-up included.\n")
-    print("| setting | candidates | wall s (mean) | 7 important, mean abs. error (mm) | "
-          + " | ".join(IMPORTANT) + " | O |")
+    print(f"| setting | candidates | wall s (mean) | {ERROR_HEADER} |")
     print("|---|---|---|---|" + "---|" * (len(IMPORTANT) + 1))
     for name, options in SETTINGS.items():
-        err = np.abs(np.array(errors[name]))
         print(f"| {name} | {_candidates(options)} | {np.mean(seconds[name]):.1f} | "
-              f"{err[:, important].mean():.1f} | "
-              + " | ".join(f"{err[:, i].mean():.1f}" for i in important)
-              + f" | {err[:, keys.index('O')].mean():.1f} |")
+              f"{error_cells(errors[name])} |")
     mean7 = {name: np.abs(np.array(errors[name]))[:, important].mean() for name in SETTINGS}
     chart = line_chart({curve: [mean7[n] for n in names] for curve, names in CURVES.items()},
                        f"fitter run, {args.subjects} in-space subjects", "wall seconds per subject",
