@@ -18,7 +18,6 @@ flight are sorted as above, and a fresh pool takes over.
 from __future__ import annotations
 
 import collections
-import contextlib
 import dataclasses
 import logging
 import multiprocessing
@@ -34,16 +33,10 @@ from bodyfit.calib.errors import UserError
 from bodyfit.calib.files import file_sha256
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome, run_subject
 
-__all__ = ["THREAD_VARIABLES", "WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker"]
+__all__ = ["WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker"]
 
 logger = logging.getLogger(__name__)
 
-#: The environment variables that size the native thread pools of NumPy's BLAS and of
-#: OpenMP; read once when a process loads them, so they are set for the workers to
-#: inherit (a user's own values are kept). One thread each: the fit's matrices are small,
-#: and more BLAS threads only spin (two BLAS threads made a worker 2.7 times slower on two
-#: cores, even alone).
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 #: How often a local worker checks that the batch that started it is still alive, seconds.
 _PARENT_CHECK_S = 0.5
 
@@ -58,7 +51,7 @@ class WorkerSetup:
             subject is fitted with the same model.
         threads: the worker's share of the CPU cores: the threads its fits score
             candidates on (unless ``--threads`` says), and torch's and OpenCV's (None:
-            their defaults; BLAS and OpenMP get one, ``THREAD_VARIABLES``).
+            their defaults; BLAS gets one in every fit, ``fitter.fit.fit_person``).
         log_level: the workers' logging level.
         devices: the kernels' devices the workers take in turn (worker i gets
             ``devices[i % len(devices)]``); empty: each job's own device.
@@ -133,21 +126,6 @@ _worker_device = None
 _worker_threads = None
 
 
-@contextlib.contextmanager
-def _single_threaded_blas():
-    """Set ``THREAD_VARIABLES`` to 1 for the block, for the workers it spawns."""
-    saved = {name: os.environ.get(name) for name in THREAD_VARIABLES}
-    for name, value in saved.items():
-        if value is None:
-            os.environ[name] = "1"
-    try:
-        yield
-    finally:
-        for name, value in saved.items():
-            if value is None:
-                os.environ.pop(name, None)
-
-
 def _watch_parent(parent_pid: int) -> None:
     """Exit when the batch that started this worker is gone (killed), rather than fit on."""
     while True:
@@ -200,9 +178,7 @@ class LocalEngine:
             UserError: the workers cannot start (not a subject's failure: it would fail
                 every subject).
         """
-        queue, deaths = collections.deque(jobs), WorkerDeaths()
-        with _single_threaded_blas():
-            self._run(queue, deaths, report)
+        self._run(collections.deque(jobs), WorkerDeaths(), report)
 
     def _run(self, queue, deaths: WorkerDeaths, report) -> None:
         while queue:

@@ -23,12 +23,10 @@ import collections
 import dataclasses
 import logging
 import math
-import os
 from collections.abc import Callable, Iterable
 
 from bodyfit.calib.errors import UserError
-from bodyfit.fitter.batch.engines import (THREAD_VARIABLES, WorkerDeaths, WorkerSetup,
-                                          start_worker)
+from bodyfit.fitter.batch.engines import WorkerDeaths, WorkerSetup, start_worker
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome, one_line, run_subject
 
 __all__ = ["RayEngine", "SubjectWorker", "import_ray"]
@@ -139,12 +137,8 @@ class RayEngine:
         if self.gpus_per_worker > 0:
             setup = dataclasses.replace(setup, devices=("cuda:0",))
         if self._actor_class is None:
-            # one BLAS and OpenMP thread, as the local workers (Ray's default is the
-            # actor's CPUs), unless the user set them
-            threads = {name: os.environ.get(name, "1") for name in THREAD_VARIABLES}
             self._actor_class = ray.remote(SubjectWorker).options(
-                num_cpus=self.cpus_per_worker, num_gpus=self.gpus_per_worker,
-                runtime_env={"env_vars": threads})
+                num_cpus=self.cpus_per_worker, num_gpus=self.gpus_per_worker)
         return self._actor_class.remote(setup)
 
     def _run(self, ray, queue: collections.deque, report) -> None:
