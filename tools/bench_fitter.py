@@ -2,6 +2,7 @@
 
     python tools/bench_fitter.py                    # 4 subjects, the settings below
     python tools/bench_fitter.py --subjects 8 --seed 3 --plot docs/fitter_error_vs_time.png
+    python tools/bench_fitter.py --device cuda:0    # the kernels on a GPU
 
 In-space subjects: bodies drawn from the model's own 20-component space (betas normal,
 clipped at +-2 sigma; limbs 2-8 degrees out), photographed front and side (the side
@@ -63,6 +64,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=7)
     parser.add_argument("--plot", type=Path, default=Path("docs/fitter_error_vs_time.png"),
                         help="error-against-time plot to write")
+    parser.add_argument("--device", default="cpu", help="`fitter run --device` (cpu, cuda:0)")
     args = parser.parse_args()
     model = load_model()
     rng = np.random.default_rng(args.seed)
@@ -73,12 +75,14 @@ def main() -> None:
             folder = Path(scratch) / f"s{i}"
             folder.mkdir()
             truth = write_subject(folder, model, *draw_subject(rng))
-            fit_each_setting(folder, truth, SETTINGS, PHOTO_OPTIONS, errors, seconds)
+            fit_each_setting(folder, truth, SETTINGS, [*PHOTO_OPTIONS, "--device", args.device],
+                             errors, seconds)
     keys = list(MEASUREMENTS)
     important = [keys.index(k) for k in IMPORTANT]
-    print(f"`python tools/bench_fitter.py --subjects {args.subjects} --seed {args.seed}` on "
-          f"{time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
-          f"`fitter run` on the CPU, start-up included.\n")
+    device = "" if args.device == "cpu" else f" --device {args.device}"
+    print(f"`python tools/bench_fitter.py --subjects {args.subjects} --seed {args.seed}{device}` "
+          f"on {time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
+          f"`fitter run` on {args.device}, start-up included.\n")
     print(f"| setting | candidates | wall s (mean) | {ERROR_HEADER} |")
     print("|---|---|---|---|" + "---|" * (len(IMPORTANT) + 1))
     for name, options in SETTINGS.items():
