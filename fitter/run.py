@@ -88,6 +88,7 @@ def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fi
             "generations": result.generations,
             "stop_reasons": {k: str(v) for k, v in result.stop_reasons.items()},
             "best_cost_per_generation": result.best_costs.tolist(),
+            "best_betas_per_generation": result.best_betas.round(4).tolist(),
         },
         "timings_s": {k: round(v, 3) for k, v in fit.seconds.items()},
     }

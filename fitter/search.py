@@ -103,6 +103,8 @@ class SearchResult:
         part_costs: (11,) float32, the best candidate's terms (``kernels.TERM_NAMES``).
         best_costs, mean_costs: (G,) per generation, the best so far and the mean of the
             finite costs of that generation.
+        best_betas: (G, K) per generation, the betas of the best candidate so far (the
+            first candidate until one is scored).
         final_genes: (P, K + 4) float64 the last population (all K betas, then the pose),
             ``final_costs`` (P,) its costs.
         evaluations: candidates scored; generations: G; seconds: wall time.
@@ -115,6 +117,7 @@ class SearchResult:
     part_costs: np.ndarray
     best_costs: np.ndarray
     mean_costs: np.ndarray
+    best_betas: np.ndarray
     final_genes: np.ndarray
     final_costs: np.ndarray
     evaluations: int
@@ -151,7 +154,8 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
     optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
                                population=settings.population, seed=settings.seed, **options)
     start = time.perf_counter()
-    best_costs, mean_costs = [], []
+    best_costs, mean_costs, best_genes = [], [], []
+    running = (np.inf, None)  # the best cost and genes scored so far
     with tqdm(desc=f"search ({settings.optimizer})", unit="gen", dynamic_ncols=True,
               disable=None if progress is None else not progress) as bar:
         while not optimizer.stop():
@@ -159,6 +163,9 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
             costs = evaluator.evaluate(betas_of(genes), genes[:, k:]).costs.astype(np.float64)
             optimizer.tell(genes, costs)
             finite = costs[np.isfinite(costs)]
+            if finite.size and finite.min() < running[0]:
+                running = (finite.min(), genes[np.flatnonzero(costs == finite.min())[0]])
+            best_genes.append(genes[0] if running[1] is None else running[1])
             best_costs.append(optimizer.best_cost)
             mean_costs.append(float(finite.mean()) if finite.size else np.inf)
             bar.update(1)
@@ -172,6 +179,7 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
     return SearchResult(
         betas=best_betas[0], pose_deg=best[0, k:], cost=result.best_cost,
         part_costs=scored.part_costs[0], best_costs=np.array(best_costs),
+        best_betas=betas_of(np.array(best_genes)),
         mean_costs=np.array(mean_costs),
         final_genes=np.concatenate([betas_of(result.population), result.population[:, k:]],
                                    axis=1),

@@ -29,7 +29,7 @@ from bodyfit import kernels
 from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, BodyModel, rest_shape
 
-__all__ = ["SIDE_ARMS", "arms_down_deg", "side_view_options", "side_photo_pose"]
+__all__ = ["SIDE_ARMS", "arms_down_deg", "arms_down_angle", "side_view_options", "side_photo_pose"]
 
 #: How a fit's side view treats the arms; the first is the default.
 SIDE_ARMS = ("down", "hidden")
@@ -37,20 +37,25 @@ _SHOULDERS = (POSE_NAMES[0], POSE_NAMES[1])
 
 
 def arms_down_deg(model: BodyModel, betas: np.ndarray | None = None) -> float:
-    """Shoulder abduction (degrees, negative) that hangs a body's arms straight down.
-
-    The angle that puts the centroid of the left hand's vertices directly below the left
-    shoulder joint, in the frontal plane (the hand moves rigidly with the shoulder chain;
-    the body is left-right symmetric, so the right side needs the same angle).
-
-    Args:
-        model: the body model.
-        betas: (K,) shape coefficients in sigma; None: the mean body.
-    """
+    """Shoulder abduction (degrees, negative) that hangs a body's arms straight down:
+    :func:`arms_down_angle` of the body of ``betas`` ((K,) in sigma; None: the mean body)."""
     betas = np.zeros((1, 1)) if betas is None else np.atleast_2d(betas)
     rest, joints = rest_shape(model, betas)
+    return arms_down_angle(model, rest[0], joints[0])
+
+
+def arms_down_angle(model: BodyModel, rest: np.ndarray, joints: np.ndarray) -> float:
+    """Shoulder abduction (degrees, negative) that hangs the arms of a body in the model's
+    topology straight down: the angle that puts the centroid of the left hand's vertices
+    directly below the left shoulder joint, in the frontal plane (the hand moves rigidly
+    with the shoulder chain; the body is left-right symmetric, so the right side needs
+    the same angle).
+
+    Args:
+        rest: (V, 3) rest vertices, metres; joints: (4, 3) its rig joints, metres.
+    """
     hand = (model.vertex_parts == PART_NAMES.index("hand")) & (model.chain_weights[:, 0] > 0.5)
-    dx, _, dz = rest[0, hand].mean(axis=0) - joints[0, 0]
+    dx, _, dz = rest[hand].mean(axis=0) - joints[0]
     return -float(np.degrees(np.arctan2(dx, -dz)))
 
 

@@ -92,7 +92,7 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
     return canvas
 
 
-__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "write_subject", "write_pinhole_photos",
+__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "lens_photo", "write_subject", "write_pinhole_photos",
            "write_pinhole_subject"]
 
 
@@ -132,23 +132,30 @@ def write_pinhole_photos(folder, model, betas, pose_deg, camera: Camera, distanc
     """Write front.png and side.png through ``camera`` into ``folder``; return the true
     measurements (key -> mm) of the rest body.
 
-    Each view is :func:`pinhole_photo` through ``camera.K`` at ``camera.image_size_px``
-    (both from the same distance and height; the side photo's arms as ``side_arms``), then
-    recorded through the lens's distortion ``camera.dist``
-    (:func:`bodyfit.calib.synthetic.distort_image`; the backdrop fills where the lens sees
-    beyond the pinhole picture), as the camera's sensor records it.
+    Each view is :func:`lens_photo` (both from the same distance and height; the side
+    photo's arms as ``side_arms``), as the camera's sensor records it.
     """
     folder = Path(folder)
     betas, pose_deg = np.atleast_2d(betas), np.atleast_2d(pose_deg)
     views = {"front": (forward(model, betas, pose_deg)[0], PART_NAMES),
              "side": _side_body(model, betas, pose_deg, side_arms)}
     for view, (posed, parts) in views.items():
-        image = pinhole_photo(posed.astype(np.float64), model, view, parts, camera.K,
-                              camera.image_size_px, distance_m, camera_height_m)
-        if np.any(camera.dist):
-            image = distort_image(image, camera.K, camera.dist, BACKDROP_BGR)
-        write_image(folder / f"{view}.png", image)
+        write_image(folder / f"{view}.png",
+                    lens_photo(posed, model, view, parts, camera, distance_m, camera_height_m))
     return Measurer.from_model(model).measure(rest_shape(model, betas)[0][0])
+
+
+def lens_photo(vertices, model, view: str, parts, camera: Camera, distance_m: float,
+               camera_height_m: float) -> np.ndarray:
+    """(H, W, 3) uint8 BGR: :func:`pinhole_photo` of posed ``vertices`` (V, 3) metres
+    through ``camera.K`` at ``camera.image_size_px``, recorded through the lens's
+    distortion ``camera.dist`` (:func:`bodyfit.calib.synthetic.distort_image`; the
+    backdrop fills where the lens sees beyond the pinhole picture)."""
+    image = pinhole_photo(np.asarray(vertices, np.float64), model, view, parts, camera.K,
+                          camera.image_size_px, distance_m, camera_height_m)
+    if np.any(camera.dist):
+        image = distort_image(image, camera.K, camera.dist, BACKDROP_BGR)
+    return image
 
 
 def write_pinhole_subject(folder, model, betas, pose_deg, intrinsics: np.ndarray,

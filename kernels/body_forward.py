@@ -12,7 +12,7 @@ import numpy as np
 
 from bodyfit.kernels.body_layout import POSE_NAMES, POSE_SIDES
 
-__all__ = ["rest_shape", "abduction_rotations", "forward"]
+__all__ = ["rest_shape", "abduction_rotations", "blend_skinning", "forward"]
 
 
 def rest_shape(model, betas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -81,8 +81,24 @@ def forward(model, betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
         raise ValueError(f"betas must be (P, K) and pose (P, 4); got {betas.shape} "
                          f"and {pose_deg.shape}")
     rest, joints = rest_shape(model, betas)
-    rot_t = abduction_rotations(pose_deg).transpose(0, 1, 3, 2)  # (P, 4, 3, 3), R^T
-    weights = model.chain_weights.astype(np.float64)  # (V, 4)
+    return blend_skinning(model.chain_weights, rest, joints, abduction_rotations(pose_deg))
+
+
+def blend_skinning(chain_weights: np.ndarray, rest: np.ndarray, joints: np.ndarray,
+                   rotations: np.ndarray) -> np.ndarray:
+    """Eq. 2, linear blend skinning of rest bodies by any rotation of each chain.
+
+    Args:
+        chain_weights: (V, 4) float, each vertex's weight on each moving chain.
+        rest: (P, V, 3) float, metres, rest vertices; joints: (P, 4, 3) float, metres.
+        rotations: (P, 4, 3, 3) float, each chain's rotation about its joint (acting on
+            column vectors).
+
+    Returns:
+        (P, V, 3) float32 posed vertices, metres.
+    """
+    rot_t = np.asarray(rotations, dtype=np.float64).transpose(0, 1, 3, 2)  # R^T
+    weights = np.asarray(chain_weights, dtype=np.float64)  # (V, 4)
     # posed = (1 - sum_c w_c) v + sum_c w_c (R_c (v - j_c) + j_c), rows as row vectors
     posed = rest * (1.0 - weights.sum(axis=1))[:, None]
     for c in range(weights.shape[1]):

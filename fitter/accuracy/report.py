@@ -1,0 +1,109 @@
+"""The accuracy benchmark's Markdown tables: the paper's Table 3 and Table 4 forms, the
+ISO 20685-1 check, the spread's coverage, failures, time and memory.
+
+Reference columns (mean +- sd of |error|, mm): the paper's own (Hemati & Bastanfard,
+Table 3) and the best published column of its Table 3 (../shared/BENCHMARK.md).
+ISO 20685-1 allows a scanner's measurements to differ from a skilled measurer's by at
+most 4 mm for heights, small girths and breadths, 5 mm for segment lengths and 9 mm for
+the large girths (chest, waist, hip); it tests a bias: the 95 % confidence interval of
+the mean signed error must lie within the allowance.
+"""
+
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+
+from bodyfit.fitter.accuracy.scores import (IMPORTANT_COLUMNS, KEYS, ErrorStats, RunScores,
+                                            error_stats)
+from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
+
+__all__ = ["PAPER", "BEST_PUBLISHED", "ISO_ALLOWANCE_MM", "measurement_table",
+           "important_table", "iso_verdicts", "failure_lines", "mean_of_important"]
+
+#: The paper's Table 3 (mean, sd of |error|, mm), and its mean of the 7 important.
+PAPER = {"A": (3.1, 3.5), "B": (2.1, 2.0), "C": (2.2, 3.5), "D": (2.5, 3.2), "E": (5.1, 7.1),
+         "F": (3.3, 5.5), "G": (3.0, 3.1), "H": (3.2, 3.4), "I": (3.1, 3.2), "J": (3.9, 2.8),
+         "K": (3.2, 4.8), "L": (2.6, 4.4), "M": (3.2, 2.1), "N": (2.9, 1.8), "O": (5.1, 6.2),
+         "P": (2.1, 2.9), "mean": (2.8, 4.0)}
+#: The best column of the paper's Table 3 for each measurement: (mean, sd, method).
+BEST_PUBLISHED = {
+    "A": (2.0, 3.0, "HS-2-Net-MM"), "B": (1.9, 1.5, "UF-US-HKS-2"), "C": (1.5, 2.2, "BfSNet"),
+    "D": (2.0, 1.0, "HS-2-Net-MM"), "E": (4.8, 7.5, "BfSNet"), "F": (3.0, 5.1, "BfSNet"),
+    "G": (1.6, 1.3, "UF-US-HKS-2"), "H": (2.0, 1.0, "HS-2-Net-MM"),
+    "I": (1.0, 1.0, "HS-2-Net-MM"), "J": (1.7, 2.4, "BfSNet"), "K": (1.5, 2.7, "BfSNet"),
+    "L": (2.4, 4.0, "BfSNet"), "M": (2.3, 3.6, "BfSNet"), "N": (1.4, 1.1, "UF-US-HKS-2"),
+    "O": (2.3, 4.6, "BfSNet"), "P": (1.9, 2.5, "BfSNet"), "mean": (3.0, 4.7, "BfSNet")}
+#: ISO 20685-1's allowance, mm: large girths 9, segment lengths 5, the rest (heights,
+#: small girths, breadths) 4.
+ISO_ALLOWANCE_MM = {key: 9.0 if key in "DEF" else 5.0 if key in "CJK" else 4.0
+                    for key in MEASUREMENTS}
+
+
+def _cell(mean: float, sd: float) -> str:
+    return f"{mean:.1f} ± {sd:.1f}"
+
+
+def measurement_table(scores: RunScores) -> list[str]:
+    """Table 3 form for one run: every measurement's |error| mean +- sd with the 95 %
+    interval of the mean, the signed mean with its interval, ISO 20685-1's verdict, how
+    often the spread covers the truth, and the paper's and best published columns."""
+    s = error_stats(scores.errors, scores.spreads)
+    lines = ["| measurement | mean ± sd of abs. error (mm) | 95 % CI of mean | signed mean "
+             "[95 % CI] | ISO 20685-1 allowance | ISO bias test | truth within spread | "
+             "paper | best published |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    verdicts = iso_verdicts(s)
+    for j, (key, (_, label)) in enumerate(MEASUREMENTS.items()):
+        best = BEST_PUBLISHED[key]
+        lines.append(
+            f"| {key} {label} | {_cell(s.mae[j], s.mae_sd[j])} | ±{s.mae_ci[j]:.1f} | "
+            f"{s.bias[j]:+.1f} [{s.bias[j] - s.bias_ci[j]:+.1f}, {s.bias[j] + s.bias_ci[j]:+.1f}]"
+            f" | {ISO_ALLOWANCE_MM[key]:.0f} | {verdicts[key]} | {100 * s.covered[j]:.0f} % | "
+            f"{_cell(*PAPER[key])} | {_cell(*best[:2])} ({best[2]}) |")
+    mean, sd, ci = mean_of_important(scores.errors)
+    lines.append(f"| mean of {' '.join(IMPORTANT)} | {_cell(mean, sd)} | ±{ci:.1f} | | | | | "
+                 f"{_cell(*PAPER['mean'])} | {_cell(*BEST_PUBLISHED['mean'][:2])} "
+                 f"({BEST_PUBLISHED['mean'][2]}) |")
+    return lines
+
+
+def mean_of_important(errors: np.ndarray) -> tuple[float, float, float]:
+    """(mean, sd, 95 % CI half-width) of the |error| over the 7 important measurements,
+    pooled over subjects and measurements as the paper's Table 4 does; the interval is
+    that of the subjects' own 7-measurement means."""
+    absolute = np.abs(np.asarray(errors))[:, IMPORTANT_COLUMNS]
+    per_subject = error_stats(absolute.mean(axis=1, keepdims=True))
+    return float(absolute.mean()), float(absolute.std(ddof=1)), float(per_subject.mae_ci[0])
+
+
+def important_table(runs: dict[str, RunScores]) -> list[str]:
+    """Table 4 form: one row per run, the 7 important measurements' mean |error| and
+    their mean (+- its 95 % interval), subjects and failures."""
+    lines = [f"| setting | subjects fitted | failed | {' | '.join(IMPORTANT)} | mean of 7 "
+             "(95 % CI) |", "|---|---|---|" + "---|" * len(IMPORTANT) + "---|"]
+    for name, scores in runs.items():
+        mae = np.abs(scores.errors).mean(axis=0)
+        mean, _, ci = mean_of_important(scores.errors)
+        lines.append(f"| {name} | {len(scores.ids)} | {len(scores.failures)} | "
+                     + " | ".join(f"{mae[KEYS.index(k)]:.1f}" for k in IMPORTANT)
+                     + f" | **{mean:.2f}** (±{ci:.2f}) |")
+    lines.append(f"| paper (its own model) | 500 | | "
+                 + " | ".join(f"{PAPER[k][0]:.1f}" for k in IMPORTANT)
+                 + f" | {PAPER['mean'][0]:.1f} |")
+    return lines
+
+
+def iso_verdicts(s: ErrorStats) -> dict[str, str]:
+    """key -> "pass" when the 95 % interval of the mean signed error lies within ISO
+    20685-1's allowance, else "fail"."""
+    return {key: "pass" if abs(s.bias[j]) + s.bias_ci[j] <= ISO_ALLOWANCE_MM[key] else "fail"
+            for j, key in enumerate(KEYS)}
+
+
+def failure_lines(scores: RunScores) -> list[str]:
+    """The failures counted by reason (a reason's subject-specific path left out)."""
+    reasons = collections.Counter(reason.split(": ", 1)[-1] if reason.startswith("/")
+                                  else reason for _, reason in scores.failures)
+    return [f"- {count} x {reason}" for reason, count in reasons.most_common()]

@@ -1,0 +1,193 @@
+"""Accuracy benchmark: synthetic subjects through the user's pipeline (issue 10).
+
+    # a subject set: bodies, photos through a phone camera, chessboard photos, the table
+    python tools/bench_accuracy.py make SETS/in --kind in-space --count 200 --seed 0
+    python tools/bench_accuracy.py make SETS/out --kind out-of-space --count 200 --seed 0
+    # fit it as a user would: calib capture on the board photos, then fitter batch with
+    # the calibrated camera (fitter batch options after --; resumable: rerun to continue)
+    python tools/bench_accuracy.py fit SETS/in default
+    python tools/bench_accuracy.py fit SETS/in uniform-weights -- --weights uniform
+    python tools/bench_accuracy.py fit SETS/in no-camera --camera none
+    # Markdown tables (docs/accuracy.md holds them)
+    python tools/bench_accuracy.py report --main "in-space=SETS/in:default" \
+        --ablation "uniform weights=SETS/in:uniform-weights"
+
+``make --bodies-only`` stops after drawing the bodies (bodies.npz, set.json: the
+out-of-space draw needs Anny, the photos do not), ``make`` again photographs them; a set
+or a run interrupted is continued by the same command. A run lies in SET/runs/NAME/
+(fitter batch's output) with bench.json: its command, wall time, peak memory, machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import concurrent.futures
+import json
+import multiprocessing
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bodyfit.fitter.accuracy.bodies import KINDS
+from bodyfit.fitter.accuracy.report import (failure_lines, important_table,
+                                            measurement_table)
+from bodyfit.fitter.accuracy.scores import read_scores
+from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, write_bodies,
+                                                 write_photos_of_set)
+from bodyfit.fitter.model_cache import load_model
+
+
+def _photograph(folder: str, subjects: list[int]) -> None:
+    write_photos_of_set(load_model(), Path(folder), subjects)
+
+
+def make(args) -> None:
+    folder = Path(args.set)
+    model = load_model()
+    if not (folder / "bodies.npz").exists():
+        settings = SetSettings(kind=args.kind, count=args.count, seed=args.seed,
+                               pool_per_sex=args.pool_per_sex)
+        folder.mkdir(parents=True, exist_ok=True)
+        write_bodies(model, folder, settings)
+        print(f"{folder}: {args.count} {args.kind} bodies drawn")
+    if args.bodies_only:
+        return
+    count = json.loads((folder / "set.json").read_text())["settings"]["count"]
+    write_photos_of_set(model, folder, [])  # the board photos, once
+    workers = args.workers or os.cpu_count()
+    chunks = [list(range(i, count, workers)) for i in range(workers)]
+    context = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
+        for future in [pool.submit(_photograph, str(folder), chunk) for chunk in chunks]:
+            future.result()
+    table = write_photos_of_set(model, folder, [])
+    print(f"{folder}: photographed; {table}")
+
+
+def _command(name: str) -> str:
+    """The bodyfit command ``name`` of this Python's environment (found even when the
+    environment is not activated), else the one on PATH."""
+    beside = Path(sys.executable).parent / name
+    return str(beside) if beside.exists() else name
+
+
+def fit(args, batch_options: list[str]) -> None:
+    folder = Path(args.set)
+    camera = folder / "camera.json"
+    if args.camera == "calibrated" and not camera.exists():
+        photos = sorted(str(p) for p in (folder / "board").glob("*.png"))
+        subprocess.run([_command("calib"), "capture", *photos, "--board", BOARD, "--square-mm",
+                        f"{SQUARE_MM:g}", "-o", str(camera)], check=True,
+                       stdout=subprocess.DEVNULL)
+    out = folder / "runs" / args.name
+    table = folder / "subjects.csv"
+    if args.first:  # the table's first rows: as many women as men (subject_set's order)
+        lines = table.read_text().splitlines(keepends=True)
+        table = folder / f"subjects-first{args.first}.csv"
+        table.write_text("".join(lines[:args.first + 1]))
+    command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
+               *(["--camera", str(camera)] if args.camera == "calibrated" else []),
+               *batch_options]
+    start = time.perf_counter()
+    code = subprocess.run(command).returncode
+    wall = time.perf_counter() - start
+    if code not in (0, 1):  # 1: some subjects failed (recorded in failures.csv)
+        sys.exit(f"fitter batch stopped with exit status {code}")
+    record = {"command": command, "wall_s": round(wall, 1),
+              "peak_rss_mb": round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+                                   / 1024),
+              "machine": f"{platform.machine()}, {os.cpu_count()} logical CPUs",
+              "date": time.strftime("%Y-%m-%d %H:%M")}
+    previous = out / "bench.json"
+    runs = json.loads(previous.read_text())["runs"] if previous.exists() else []
+    previous.write_text(json.dumps({"runs": [*runs, record]}, indent=1))
+    print(f"{out}: fitter batch exit {code} in {wall:.0f} s")
+
+
+def _run_spec(spec: str) -> tuple[str, Path, Path]:
+    label, _, where = spec.partition("=")
+    set_folder, _, name = where.rpartition(":")
+    return label, Path(set_folder), Path(set_folder) / "runs" / name
+
+
+def _timing(scores, run: Path) -> str:
+    runs = json.loads((run / "bench.json").read_text())["runs"]
+    wall = sum(r["wall_s"] for r in runs)
+    fitted = len(scores.ids)
+    return (f"{fitted} fitted, {len(scores.failures)} failed; each subject's job (photos "
+            f"to written results) {np.nanmedian(scores.seconds):.1f} s median, "
+            f"{np.nanmean(scores.seconds):.1f} s mean; the whole batch {wall:.0f} s wall "
+            f"({wall / max(fitted, 1):.2f} s per subject); peak memory of one process "
+            f"{max(r['peak_rss_mb'] for r in runs)} MB; {runs[-1]['machine']}; "
+            f"`{' '.join(runs[0]['command'][3:])}`")
+
+
+def report(args) -> None:
+    mains = [_run_spec(spec) for spec in args.main]
+    ablations = [_run_spec(spec) for spec in args.ablation]
+    table4 = {}
+    for label, set_folder, run in mains:
+        scores = read_scores(set_folder, run)
+        table4[label] = scores
+        print(f"### {label}\n\n{_timing(scores, run)}.\n")
+        print("\n".join(measurement_table(scores)) + "\n")
+        if 2 <= scores.hard.sum() <= len(scores.hard) - 2:
+            print("Out-of-space hard share alone: " + important_table(
+                {"hard share": _subset(scores, scores.hard),
+                 "the others": _subset(scores, ~scores.hard)})[2].split("|", 2)[2] + "\n")
+        if scores.failures:
+            print("Failures:\n\n" + "\n".join(failure_lines(scores)) + "\n")
+    for label, set_folder, run in ablations:
+        scores = read_scores(set_folder, run)
+        table4[label] = scores
+        print(f"- {label}: {_timing(scores, run)}")
+    print("\n### The 7 important measurements (Table 4 form)\n")
+    print("\n".join(important_table(table4)))
+
+
+def _subset(scores, keep):
+    import dataclasses
+    return dataclasses.replace(scores, ids=[i for i, k in zip(scores.ids, keep) if k],
+                               errors=scores.errors[keep], spreads=scores.spreads[keep],
+                               seconds=scores.seconds[keep], hard=scores.hard[keep],
+                               failures=[])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("make", help="draw and photograph a subject set")
+    p.add_argument("set", help="the set's folder")
+    p.add_argument("--kind", choices=KINDS, default="in-space")
+    p.add_argument("--count", type=int, default=200)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--pool-per-sex", type=int, default=400,
+                   help="out-of-space: bodies the population sampler's linear map is fitted on")
+    p.add_argument("--bodies-only", action="store_true")
+    p.add_argument("--workers", type=int, help="processes photographing (default: the cores)")
+    p = sub.add_parser("fit", help="calib capture, then fitter batch on a set")
+    p.add_argument("set")
+    p.add_argument("name", help="the run's name (SET/runs/NAME)")
+    p.add_argument("--camera", choices=("calibrated", "none"), default="calibrated",
+                   help="none: fitter batch without --camera (a typical phone assumed)")
+    p.add_argument("--first", type=int, help="fit only the set's first N subjects (N even: "
+                   "half women, half men)")
+    p = sub.add_parser("report", help="Markdown tables of runs")
+    p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:NAME",
+                   help="a run with its full Table 3 form")
+    p.add_argument("--ablation", action="append", default=[], metavar="LABEL=SET:NAME",
+                   help="a run in the Table 4 form only")
+    argv = sys.argv[1:]
+    batch_options = argv[argv.index("--") + 1:] if "--" in argv else []
+    args = parser.parse_args(argv[:argv.index("--")] if "--" in argv else argv)
+    {"make": make, "report": report}.get(args.command, lambda a: fit(a, batch_options))(args)
+
+
+if __name__ == "__main__":
+    main()
