@@ -57,6 +57,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "camera (70 degrees across the long side); "
                              "orthographic: the paper's, each view scaled from the stature "
                              "(default pinhole; --method paper: orthographic)")
+    parser.add_argument("--placement-rounds", type=int, metavar="N",
+                        help="pinhole: place the camera anew from the search's best body so "
+                             "far N times, evenly spaced (default 2; 0: from the mean body "
+                             "only)")
     if not batch:
         parser.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
                             "(white person on black, of the undistorted upright photo)")

@@ -18,10 +18,10 @@ from threadpoolctl import threadpool_limits
 
 from bodyfit import kernels
 from bodyfit.calib.errors import UserError
-from bodyfit.fitter.body_model import BodyModel, forward, rest_shape
+from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
-from bodyfit.fitter.pinhole_canvas import pinhole_view
+from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
 from bodyfit.fitter.side_arms import side_view_options
@@ -54,6 +54,10 @@ class FitSettings:
         projection: "pinhole" (the photos' camera, or a typical phone's without one,
             :mod:`bodyfit.fitter.pinhole_canvas`; the default) or "orthographic" (the
             paper's, each view scaled from the stature).
+        placement_rounds: pinhole only: how often the search places the cameras anew
+            from its best body so far (evenly spaced through the generations;
+            :func:`~bodyfit.fitter.pinhole_canvas.placed_anew`); 0: only from the mean
+            body, before the search.
     """
 
     search: SearchSettings = SearchSettings()
@@ -65,6 +69,7 @@ class FitSettings:
     render_cell_mm: float = 8.0
     side_arms: str = "down"
     projection: str = "pinhole"
+    placement_rounds: int = 2
 
     def validate(self, stored_components: int) -> None:
         """Raise UserError for settings no person could be fitted with (one line, naming
@@ -78,6 +83,8 @@ class FitSettings:
         if self.projection not in ("orthographic", "pinhole"):
             raise UserError(f"--projection must be orthographic or pinhole, got "
                             f"{self.projection!r}")
+        if self.placement_rounds < 0:
+            raise UserError(f"placement_rounds must be >= 0, got {self.placement_rounds}")
 
 
 #: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
@@ -89,7 +96,7 @@ METHODS = {
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False),
                          cost=kernels.CostSettings(), projection="orthographic",
-                         render_cell_mm=0.0),
+                         render_cell_mm=0.0, placement_rounds=0),
 }
 
 
@@ -141,11 +148,43 @@ def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
     """One view's target with ``settings.projection`` (``intrinsics``: (3, 3) K for pinhole;
     ``view_options``: the side view's arms, :func:`~bodyfit.fitter.side_arms.side_view_options`)."""
     if settings.projection == "pinhole":
-        return pinhole_view(name, mask, intrinsics, stature_m, extent, mean_body,
+        # placed from the mean body as the view renders it (the side view's arms hanging
+        # down: the hands reach in front of the body, and the placement's horizontal
+        # centre must see them as the photo does)
+        pose = np.zeros((1, len(POSE_NAMES)))
+        for joint, degrees in (view_options.get("fixed_pose_deg") or {}).items():
+            pose[0, POSE_NAMES.index(joint)] = degrees
+        posed_mean = forward(model, np.zeros((1, settings.search.components)), pose)[0]
+        return pinhole_view(name, mask, intrinsics, stature_m, extent, posed_mean,
                             model.vertex_parts, settings.canvas, settings.device,
                             **view_options)
     return orthographic_view(name, mask, stature_m, extent, mean_body, settings.canvas,
                              settings.device, **view_options)
+
+
+def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, settings):
+    """The search's ``on_generation`` that places the pinhole cameras anew from the best
+    body so far (:func:`~bodyfit.fitter.pinhole_canvas.placed_anew`) after each of
+    ``settings.placement_rounds`` evenly spaced generations; it updates ``views`` too."""
+    generations = settings.search.generations or 1
+    rounds = settings.placement_rounds
+    at = {round(generations * (i + 1) / (rounds + 1)) for i in range(rounds)}
+
+    def place(done: int, betas: np.ndarray, pose_deg: np.ndarray) -> bool:
+        if done not in at:
+            return False
+        rest = rest_shape(model, betas[None])[0][0]
+        scale = stature_scale(rest, stature_m)
+        for name, view in views.items():
+            body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0] * scale
+            shown = np.isin(model.vertex_parts,
+                            [PART_NAMES.index(p) for p in view.visible_parts])
+            views[name] = placed_anew(view, masks[name], intrinsics[name],
+                                      body[shown].astype(np.float64))
+            evaluator.replace_view(views[name])
+        return True
+
+    return place
 
 
 # One BLAS thread for the whole fit: its matrices are small (CMA-ES's 24 x 24, the
@@ -190,8 +229,12 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     conditioner = None
     if s.condition_stature:
         conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies)
+    replace = None
+    if settings.projection == "pinhole" and settings.placement_rounds:
+        replace = _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator,
+                                    settings)
     t1 = time.perf_counter()
-    result = search(evaluator, s, conditioner, progress)
+    result = search(evaluator, s, conditioner, progress, replace)
     t2 = time.perf_counter()
     betas = result.betas[None]
     posed = forward(model, betas, result.pose_deg[None])[0]

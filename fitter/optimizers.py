@@ -150,6 +150,11 @@ class Optimizer(abc.ABC):
         """The best cost told so far (+inf before the first tell); cheaper than ``result``."""
         return self._best_cost
 
+    def forget_best(self) -> None:
+        """Forget the best candidate told so far: the costs told from now on are not
+        comparable with the earlier ones (the views' cameras moved, say)."""
+        self._best_candidate, self._best_cost = None, np.inf
+
     @property
     @abc.abstractmethod
     def population_size(self) -> int:

@@ -19,9 +19,14 @@ The model of the scene, and its assumptions:
   two rows give two equations, linear in the person's distance and the camera's height,
   once it is known which vertices project highest and lowest and how far in front of or
   behind the body's axis they are (the toes are nearer the camera than the crown);
-  a few fixed-point rounds settle that. The person's own shape differs from the scaled mean
+  a few fixed-point rounds settle that. The body is posed and shown as the view renders
+  candidates (the side view's arms hanging down, hands in front of the body: the
+  horizontal centre must include them, or the camera lands 10 cm to one side and the side
+  view is seen 2 degrees askew). The person's own shape differs from the scaled mean
   body; the error is the difference of their depth offsets at the crown and the toes
-  (a few centimetres at 3 m: about 1 per cent of the distance).
+  (a few centimetres at 3 m: about 1 per cent of the distance), so the search places the
+  camera anew from its best body so far (:func:`placed_anew`, ``FitSettings.
+  placement_rounds``).
 - **The canvas** is a crop of the photo's mask around the person and every candidate the
   search may ask for (model extent, as the orthographic canvas), resampled so that the
   person is ``body_height_px`` tall (area resampling cut at one half); ``K`` follows the
@@ -44,10 +49,10 @@ from bodyfit import kernels
 from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import PART_NAMES
 from bodyfit.fitter.canvas import VIEW_PARTS, CanvasSettings
-from bodyfit.kernels.view_camera import paper_rotation
+from bodyfit.kernels.view_camera import camera_matrices, paper_rotation
 
 __all__ = ["PHONE_HFOV_DEG", "Placement", "phone_intrinsics", "upright_intrinsics",
-           "view_rotation", "solve_placement", "pinhole_view"]
+           "view_rotation", "solve_placement", "pinhole_view", "placed_anew"]
 
 #: Horizontal field of view across the photo's long side of the camera assumed without
 #: camera.json: a phone's main camera (26 mm equivalent focal length: 69.4 degrees).
@@ -210,9 +215,10 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
         stature_m: the person's stature, metres.
         extent: (M, 3) float32 metres, the vertices of
             :func:`bodyfit.fitter.canvas.extreme_bodies`.
-        mean_body: (V, 3) float32 metres, the mean body in its default pose.
+        mean_body: (V, 3) float32 metres, the mean body in the pose the view renders
+            candidates in (the side view's arms hanging down, say).
         vertex_parts: (V,) int, each vertex's index in ``PART_NAMES``: the placement is
-            solved with the parts the view shows (no arms in the side view).
+            solved with the parts the view renders (``visible_parts``).
         settings: canvas geometry.
         device: where the kernels run.
         view_options: ``visible_parts`` (default ``VIEW_PARTS[name]``) and
@@ -224,7 +230,8 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
     """
     k = np.asarray(intrinsics, float)
     body = mean_body.astype(np.float64) * (stature_m / np.ptp(mean_body[:, 2]))
-    shown = np.isin(vertex_parts, [PART_NAMES.index(p) for p in VIEW_PARTS[name]])
+    visible = view_options.get("visible_parts", VIEW_PARTS[name])
+    shown = np.isin(vertex_parts, [PART_NAMES.index(p) for p in visible])
     placement = solve_placement(name, mask, k, body[shown])
     r, t = placement.extrinsics(name)
     rows, cols = np.nonzero(mask)
@@ -240,3 +247,23 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
     return kernels.prepare_view_target(name, canvas, camera,
                                        1000.0 * placement.distance_m / k_canvas[1, 1],
                                        device=device, **view_options)
+
+
+def placed_anew(view: kernels.ViewTarget, mask: np.ndarray, intrinsics: np.ndarray,
+                body: np.ndarray) -> kernels.ViewTarget:
+    """``view`` (of :func:`pinhole_view`) with the camera placed from ``body`` instead of
+    the mean body: the same canvas and camera matrix, the distance and height solved by
+    :func:`solve_placement` with this body's crown and toes (the search's best body so
+    far is much nearer the person's than the mean body is; the mean body's placement
+    errs by about 1 per cent of the distance, which scales every candidate by as much).
+
+    Args:
+        view: the view to place anew; mask, intrinsics: as for :func:`pinhole_view`.
+        body: (V, 3) metres, the parts the view shows of a body of the person's stature
+            in the view's pose.
+    """
+    placement = solve_placement(view.name, mask, np.asarray(intrinsics, float), body)
+    k_canvas = camera_matrices(view.camera)[0]
+    camera = kernels.pinhole_camera(k_canvas, *placement.extrinsics(view.name))
+    return dataclasses.replace(view, camera=camera, millimetres_per_pixel=1000.0
+                               * placement.distance_m / k_canvas[1, 1])

@@ -14,7 +14,7 @@ import numpy as np
 
 from bodyfit.fitter.body_model import PART_NAMES
 
-__all__ = ["PART_COLOURS_BGR", "render_parts", "orthographic_pixels", "render_pinhole",
+__all__ = ["PART_COLOURS_BGR", "render_parts", "render_colours", "orthographic_pixels", "render_pinhole",
            "pinhole_pixels", "coverage_mask", "centre_samples", "parts_legend"]
 
 #: One BGR colour per part, ``PART_NAMES`` order.
@@ -51,11 +51,18 @@ def render_parts(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray
     Returns:
         (height_px, W, 3) uint8 BGR image on white, W fitted to the body.
     """
+    return render_colours(vertices, faces, PART_COLOURS_BGR[face_parts], view, height_px,
+                          margin_px)
+
+
+def render_colours(vertices: np.ndarray, faces: np.ndarray, face_colours: np.ndarray,
+                   view: str, height_px: int = 600, margin_px: float = 10) -> np.ndarray:
+    """:func:`render_parts` with any colour per face: ``face_colours`` (F, 3) BGR 0-255."""
     right, toward = _VIEWS[view]
     px = orthographic_pixels(vertices, view, height_px, margin_px)
     width = int(np.ceil(px[:, 0].max() + margin_px))
     image = np.full((height_px, width, 3), 255, np.uint8)
-    return _paint(image, px, vertices @ toward, vertices, faces, face_parts, toward)
+    return _paint(image, px, vertices @ toward, vertices, faces, face_colours, toward)
 
 
 def orthographic_pixels(vertices: np.ndarray, view: str, height_px: int,
@@ -87,7 +94,7 @@ def render_pinhole(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarr
     """
     px, depth = pinhole_pixels(vertices, intrinsics, rotation, translation_m)
     image = np.full((size_px[1], size_px[0], 3), 255, np.uint8)
-    return _paint(image, px, -depth, vertices, faces, face_parts,
+    return _paint(image, px, -depth, vertices, faces, PART_COLOURS_BGR[face_parts],
                   -np.asarray(rotation, float)[2])
 
 
@@ -157,14 +164,15 @@ def centre_samples(px: np.ndarray, faces: np.ndarray, size_px: tuple[int, int]) 
     return out
 
 
-def _paint(image, px, toward_depth, vertices, faces, face_parts, toward) -> np.ndarray:
+def _paint(image, px, toward_depth, vertices, faces, face_colours, toward) -> np.ndarray:
     """Fill each triangle of ``px`` ((V, 2) pixels) far to near (small ``toward_depth``
-    first), shaded by how squarely it faces ``toward`` (unit vector to the viewer)."""
+    first) with its colour ((F, 3) BGR), shaded by how squarely it faces ``toward`` (unit
+    vector to the viewer)."""
     tri = vertices[faces]
     normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     normals /= np.linalg.norm(normals, axis=1, keepdims=True) + 1e-12
     shade = 0.35 + 0.65 * np.abs(normals @ toward)
-    colours = PART_COLOURS_BGR[face_parts] * shade[:, None]
+    colours = np.asarray(face_colours, np.float64) * shade[:, None]
     polygons = np.round(px[faces] * (1 << _SUBPIXEL_BITS)).astype(np.int32)
     for f in np.argsort(toward_depth[faces].mean(axis=1)):  # far (small "toward") to near
         cv2.fillPoly(image, [polygons[f]], colours[f].tolist(), lineType=cv2.LINE_AA,

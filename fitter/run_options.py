@@ -48,8 +48,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     """``base`` with every fit option of ``options`` that is not None applied: the search's
     (``SEARCH_OPTIONS``, ``free_stature``), the cost's (``matching``, ``vertical_anchor``,
     ``weights`` (a preset or a .toml file, replacing the weights) and ``weight`` (a list of
-    ``NAME=VALUE`` overrides on top)), ``device``, ``threads``, ``side_arms`` and
-    ``projection``.
+    ``NAME=VALUE`` overrides on top)), ``device``, ``threads``, ``side_arms``,
+    ``projection`` and ``placement_rounds``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -71,4 +71,6 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
                                device=given.get("device", base.device),
                                threads=given.get("threads", base.threads),
                                side_arms=given.get("side_arms", base.side_arms),
-                               projection=given.get("projection", base.projection))
+                               projection=given.get("projection", base.projection),
+                               placement_rounds=given.get("placement_rounds",
+                                                          base.placement_rounds))

@@ -127,7 +127,7 @@ class SearchResult:
 
 
 def search(evaluator, settings: SearchSettings, conditioner=None,
-           progress: bool | None = None) -> SearchResult:
+           progress: bool | None = None, on_generation=None) -> SearchResult:
     """Search the body space against the evaluator's views.
 
     Args:
@@ -138,6 +138,10 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
             ``settings.condition_stature``: it turns the searched genes into full betas.
         progress: a progress bar with the best cost per generation on stderr (None: only
             when stderr is a terminal).
+        on_generation: None, or called after each generation with (generations done, the
+            best candidate's betas (K,), its pose (4,)); when it returns True, the costs
+            from the next generation on are not comparable with the earlier ones (it moved
+            the evaluator's cameras), and the best so far is forgotten.
     """
     k = settings.searched_betas
     if settings.condition_stature and conditioner is None:
@@ -170,6 +174,10 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
             mean_costs.append(float(finite.mean()) if finite.size else np.inf)
             bar.update(1)
             bar.set_postfix(best=f"{best_costs[-1]:.1f}")
+            if on_generation is not None and running[1] is not None and on_generation(
+                    len(best_costs), betas_of(running[1][None])[0], running[1][k:]):
+                optimizer.forget_best()
+                running = (np.inf, None)
     result = optimizer.result
     if not np.isfinite(result.best_cost):
         raise UserError("no candidate body produced a silhouette; check the photos and masks")

@@ -196,6 +196,19 @@ class PopulationEvaluator:
             for module in _KERNEL_MODULES:
                 wp.load_module(module, device=model.device)
 
+    def replace_view(self, view: ViewTarget) -> None:
+        """Score the next populations against ``view`` in place of the view of its name
+        that differs from it only in its camera and ``millimetres_per_pixel`` (the person
+        placed anew); the canvas and everything computed from the person stay."""
+        for group in self._pose_groups.values():
+            for data in group:
+                if data.view.name == view.name:
+                    data.view = view
+                    data.params = cost_params(self.settings, view.name,
+                                              view.millimetres_per_pixel)
+                    return
+        raise ValueError(f"this evaluator has no view {view.name!r}")
+
     def buffer_bytes(self) -> int:
         """Bytes of device memory held by this evaluator (model data excluded)."""
         return sum(a.capacity for space in self._workspaces for a in space.arrays())

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import csv
+import dataclasses
 import json
 import multiprocessing
 import os
@@ -32,15 +34,22 @@ import sys
 import time
 from pathlib import Path
 
+import cv2
 import numpy as np
 
+from bodyfit.calib.images import write_image
 from bodyfit.fitter.accuracy.bodies import KINDS
+from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, error_per_generation,
+                                             fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table,
                                             measurement_table)
 from bodyfit.fitter.accuracy.scores import read_scores
-from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, write_bodies,
+from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
+                                                 subject_ids, write_bodies,
                                                  write_photos_of_set)
+from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.model_cache import load_model
+from bodyfit.fitter.plots import line_chart
 
 
 def _photograph(folder: str, subjects: list[int]) -> None:
@@ -87,10 +96,18 @@ def fit(args, batch_options: list[str]) -> None:
                        stdout=subprocess.DEVNULL)
     out = folder / "runs" / args.name
     table = folder / "subjects.csv"
+    lines = table.read_text().splitlines(keepends=True)
     if args.first:  # the table's first rows: as many women as men (subject_set's order)
-        lines = table.read_text().splitlines(keepends=True)
+        lines = lines[:args.first + 1]
         table = folder / f"subjects-first{args.first}.csv"
-        table.write_text("".join(lines[:args.first + 1]))
+    if args.rest_of:  # the subjects another run has not fitted (a run continued elsewhere)
+        with open(folder / "runs" / args.rest_of / "summary.csv", newline="") as file:
+            done = {row["id"] for row in csv.DictReader(file)
+                    if row["status"] in ("fitted", "fitted earlier")}
+        lines = [lines[0], *(line for line in lines[1:] if line.split(",")[0] not in done)]
+        table = folder / f"subjects-rest-of-{args.rest_of}.csv"
+    if table != folder / "subjects.csv":
+        table.write_text("".join(lines))
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
                *(["--camera", str(camera)] if args.camera == "calibrated" else []),
                *batch_options]
@@ -110,32 +127,50 @@ def fit(args, batch_options: list[str]) -> None:
     print(f"{out}: fitter batch exit {code} in {wall:.0f} s")
 
 
-def _run_spec(spec: str) -> tuple[str, Path, Path]:
+def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
+    """LABEL=SET:NAME[+NAME2...] -> (label, the set, its runs' folders)."""
     label, _, where = spec.partition("=")
-    set_folder, _, name = where.rpartition(":")
-    return label, Path(set_folder), Path(set_folder) / "runs" / name
+    set_folder, _, names = where.rpartition(":")
+    return label, Path(set_folder), [Path(set_folder) / "runs" / n for n in names.split("+")]
 
 
-def _timing(scores, run: Path) -> str:
-    runs = json.loads((run / "bench.json").read_text())["runs"]
-    wall = sum(r["wall_s"] for r in runs)
-    fitted = len(scores.ids)
-    return (f"{fitted} fitted, {len(scores.failures)} failed; each subject's job (photos "
-            f"to written results) {np.nanmedian(scores.seconds):.1f} s median, "
-            f"{np.nanmean(scores.seconds):.1f} s mean; the whole batch {wall:.0f} s wall "
-            f"({wall / max(fitted, 1):.2f} s per subject); peak memory of one process "
-            f"{max(r['peak_rss_mb'] for r in runs)} MB; {runs[-1]['machine']}; "
-            f"`{' '.join(runs[0]['command'][3:])}`")
+def _scores(set_folder: Path, runs: list[Path]):
+    """The runs' scores as one run's (runs that share no subject)."""
+    parts = [read_scores(set_folder, run) for run in runs]
+    return dataclasses.replace(
+        parts[0], ids=[i for p in parts for i in p.ids],
+        **{field: np.concatenate([getattr(p, field) for p in parts])
+           for field in ("errors", "spreads", "seconds", "hard")},
+        failures=[f for p in parts for f in p.failures])
+
+
+def _timing(scores, runs: list[Path]) -> str:
+    lines = []
+    for run in runs:
+        if not (run / "batch.json").exists():  # fitter batch was stopped before its end
+            lines.append(f"{run.name}: stopped before its end, no timing recorded")
+            continue
+        record = json.loads((run / "bench.json").read_text())["runs"]
+        batch = json.loads((run / "batch.json").read_text())
+        fitted = batch["subjects"]["fitted"]
+        wall = batch["seconds"]["total"]
+        lines.append(f"{fitted} subjects in {wall:.0f} s wall ({wall / max(fitted, 1):.2f} s "
+                     f"per subject, {batch['workers']} workers, "
+                     f"{' '.join(record[0]['command'][5:])}) on {record[-1]['machine']}; peak "
+                     f"memory of one process {max(r['peak_rss_mb'] for r in record)} MB")
+    return (f"{len(scores.ids)} fitted, {len(scores.failures)} failed; each subject's job "
+            f"(photos to written results) {np.nanmedian(scores.seconds):.1f} s median; "
+            + "; ".join(lines))
 
 
 def report(args) -> None:
     mains = [_run_spec(spec) for spec in args.main]
     ablations = [_run_spec(spec) for spec in args.ablation]
     table4 = {}
-    for label, set_folder, run in mains:
-        scores = read_scores(set_folder, run)
+    for label, set_folder, runs in mains:
+        scores = _scores(set_folder, runs)
         table4[label] = scores
-        print(f"### {label}\n\n{_timing(scores, run)}.\n")
+        print(f"### {label}\n\n{_timing(scores, runs)}.\n")
         print("\n".join(measurement_table(scores)) + "\n")
         if 2 <= scores.hard.sum() <= len(scores.hard) - 2:
             print("Out-of-space hard share alone: " + important_table(
@@ -143,20 +178,60 @@ def report(args) -> None:
                  "the others": _subset(scores, ~scores.hard)})[2].split("|", 2)[2] + "\n")
         if scores.failures:
             print("Failures:\n\n" + "\n".join(failure_lines(scores)) + "\n")
-    for label, set_folder, run in ablations:
-        scores = read_scores(set_folder, run)
+    for label, set_folder, runs in ablations:
+        scores = _scores(set_folder, runs)
         table4[label] = scores
-        print(f"- {label}: {_timing(scores, run)}")
+        print(f"- {label}: {_timing(scores, runs)}")
     print("\n### The 7 important measurements (Table 4 form)\n")
     print("\n".join(important_table(table4)))
 
 
 def _subset(scores, keep):
-    import dataclasses
     return dataclasses.replace(scores, ids=[i for i, k in zip(scores.ids, keep) if k],
                                errors=scores.errors[keep], spreads=scores.spreads[keep],
                                seconds=scores.seconds[keep], hard=scores.hard[keep],
                                failures=[])
+
+
+def figures(args) -> None:
+    """Fig. 12 (error per generation) and Figs. 16-17 (bodies coloured by distance)."""
+    model = load_model()
+    folder = Path(args.set)
+    runs = {label: folder / "runs" / name for label, name in
+            (spec.split("=", 1) for spec in args.curve)}
+    generations = [g for g in (1, 2, 3, 5, 8, 12, 18, 25, 35, 50, 70, 100, 125, 150, 200)
+                   if g <= args.generations]
+    curves, counts = {}, {}
+    for label, run in runs.items():
+        curves[label], counts[label] = error_per_generation(model, folder, run, generations)
+        print(f"{label}: {counts[label]} subjects; " + ", ".join(
+            f"g{g} {e:.1f}" for g, e in zip(generations, curves[label])))
+    chart = line_chart(curves, f"{args.title}: best body so far", "generation",
+                       "7 important measurements, mean abs. error (mm)", log_y=True,
+                       x_values={label: generations for label in curves})
+    write_image(Path(args.docs) / "accuracy_error_per_generation.png", chart)
+    bodies = read_bodies(model, folder)
+    ids = subject_ids(len(bodies.sex), bodies.sex)
+    shown = [runs[label] for label in args.meshes]
+    candidates = [i for i, s in enumerate(ids) if all((r / s / "run.json").exists() for r in shown)]
+    measurer = Measurer.from_model(model)
+    waist = np.array([measurer.measure(bodies.vertices[i])["E"] for i in candidates])
+    rows = []
+    for name, q in (("thin", 0.03), ("normal", 0.5), ("heavy", 0.97)):
+        index = candidates[int(np.argsort(waist)[int(q * (len(waist) - 1))])]
+        panel = distance_panel(model, bodies.vertices[index],
+                               [fitted_rest_body(model, run, ids[index]) for run in shown])
+        caption = np.full((28, panel.shape[1], 3), 255, np.uint8)
+        cv2.putText(caption, f"{name}: {ids[index]}, waist {waist[candidates.index(index)]:.0f} mm"
+                    f" - truth | " + " | ".join(args.meshes), (8, 20),
+                    cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
+        rows.append(np.vstack([caption, panel]))
+    width = max(r.shape[1] for r in rows)
+    rows = [np.hstack([r, np.full((r.shape[0], width - r.shape[1], 3), 255, np.uint8)])
+            for r in rows]
+    write_image(Path(args.docs) / "accuracy_meshes.png",
+                np.vstack([*rows, colour_bar(width)]))
+    print(f"wrote {args.docs}/accuracy_error_per_generation.png, {args.docs}/accuracy_meshes.png")
 
 
 def main() -> None:
@@ -176,6 +251,8 @@ def main() -> None:
     p.add_argument("name", help="the run's name (SET/runs/NAME)")
     p.add_argument("--camera", choices=("calibrated", "none"), default="calibrated",
                    help="none: fitter batch without --camera (a typical phone assumed)")
+    p.add_argument("--rest-of", metavar="RUN", help="fit only the subjects the run RUN of "
+                   "this set has not fitted (RUN's summary.csv); report both as RUN+NAME")
     p.add_argument("--first", type=int, help="fit only the set's first N subjects (N even: "
                    "half women, half men)")
     p = sub.add_parser("report", help="Markdown tables of runs")
@@ -183,10 +260,19 @@ def main() -> None:
                    help="a run with its full Table 3 form")
     p.add_argument("--ablation", action="append", default=[], metavar="LABEL=SET:NAME",
                    help="a run in the Table 4 form only")
+    p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
+    p.add_argument("set")
+    p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
+                   help="a run of SET drawn in the error-per-generation chart")
+    p.add_argument("--meshes", nargs="+", default=[], metavar="LABEL",
+                   help="the curves' runs whose fitted bodies are drawn")
+    p.add_argument("--generations", type=int, default=150)
+    p.add_argument("--title", default="in-space subjects")
+    p.add_argument("--docs", default="docs")
     argv = sys.argv[1:]
     batch_options = argv[argv.index("--") + 1:] if "--" in argv else []
     args = parser.parse_args(argv[:argv.index("--")] if "--" in argv else argv)
-    {"make": make, "report": report}.get(args.command, lambda a: fit(a, batch_options))(args)
+    {"make": make, "report": report, "figures": figures}.get(args.command, lambda a: fit(a, batch_options))(args)
 
 
 if __name__ == "__main__":

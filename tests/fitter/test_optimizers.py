@@ -336,3 +336,35 @@ def test_best_cost_is_the_results(name):
         x = opt.ask()
         opt.tell(x, np.sum(x ** 2, axis=1))
         assert opt.best_cost == opt.result.best_cost
+
+
+def test_search_forgets_the_best_when_the_costs_change_meaning():
+    """on_generation sees every generation's best so far; once it says the costs changed
+    (True), the best so far restarts from the next generation's costs."""
+    from types import SimpleNamespace
+
+    from bodyfit.fitter.search import SearchSettings, search
+
+    offset = {"value": 0.0}
+
+    class Evaluator:
+        def evaluate(self, betas, pose_deg):
+            return SimpleNamespace(costs=np.sum(betas ** 2, axis=1) + offset["value"],
+                                   part_costs=np.zeros((len(betas), 11)))
+
+    seen = []
+
+    def on_generation(done, betas, pose_deg):
+        seen.append(done)
+        assert betas.shape == (3,) and pose_deg.shape == (4,)
+        if done == 4:
+            offset["value"] = 100.0  # every cost from now on is 100 higher
+            return True
+        return False
+
+    settings = SearchSettings(optimizer="cmaes", population=6, generations=8, components=3,
+                              condition_stature=False, seed=1)
+    result = search(Evaluator(), settings, on_generation=on_generation, progress=False)
+    assert seen == list(range(1, 9))
+    assert np.all(result.best_costs[:4] < 100) and np.all(result.best_costs[4:] >= 100)
+    assert result.cost >= 100 and len(result.best_betas) == 8

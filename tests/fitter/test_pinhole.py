@@ -14,7 +14,9 @@ from bodyfit.fitter.body_model import PART_NAMES, forward
 from bodyfit.fitter.canvas import VIEW_PARTS, extreme_bodies
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.pinhole_canvas import (Placement, phone_intrinsics, pinhole_view,
-                                           solve_placement, upright_intrinsics)
+                                           placed_anew, solve_placement, upright_intrinsics)
+from bodyfit.fitter.side_arms import side_photo_pose
+from bodyfit.kernels import ModelArrays, PopulationEvaluator
 from bodyfit.fitter.run import RUN_FILES
 from bodyfit.calib.silhouette import photo_silhouette
 from bodyfit.fitter.studio_photos import (BACKDROP_BGR, pinhole_photo, write_pinhole_photos,
@@ -111,6 +113,38 @@ def test_solved_distance_of_another_body(body_model, mean_body, tmp_path, distan
         placement = solve_placement(view, mask, K_TRUE, body[shown])
         assert placement.distance_m == pytest.approx(distance_m, rel=0.02), view
         assert placement.height_m == pytest.approx(height_m, abs=0.05), view
+
+
+def test_placed_anew_from_the_persons_own_body(body_model, mean_body, tmp_path):
+    """Placed from the person's own body, the camera's distance is nearer the truth than
+    from the mean body; the canvas and K stay; an evaluator given the new view scores
+    as one built with it."""
+    distance_m = 3.0
+    truth = write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, SUBJECT_POSE, K_TRUE,
+                                  SIZE_PX, distance_m, 1.2)
+    extent = extreme_bodies(body_model, 20, [-5.0] * 4, [30.0] * 4).reshape(-1, 3)
+    poses = {"front": SUBJECT_POSE, "side": side_photo_pose(body_model, SUBJECT_BETAS,
+                                                             SUBJECT_POSE)}
+    arrays = ModelArrays.from_body_model(body_model, 20)
+    for view, pose in poses.items():
+        mask = person_mask(cv2.imread(str(tmp_path / f"{view}.png")))
+        target = pinhole_view(view, mask, K_TRUE, truth["O"] / 1000, extent, mean_body,
+                              body_model.vertex_parts)
+        body = forward(body_model, SUBJECT_BETAS[None], pose[None])[0].astype(np.float64)
+        shown = np.isin(body_model.vertex_parts, [PART_NAMES.index(p) for p in VIEW_PARTS[view]])
+        anew = placed_anew(target, mask, K_TRUE, body[shown])
+        k_canvas = camera_matrices(target.camera)[0]
+        np.testing.assert_allclose(camera_matrices(anew.camera)[0], k_canvas)
+        true_scale = 1000 * distance_m / k_canvas[1, 1]
+        error_anew = abs(anew.millimetres_per_pixel / true_scale - 1)
+        assert error_anew < 0.004, view
+        assert error_anew < abs(target.millimetres_per_pixel / true_scale - 1), view
+        betas = np.array([SUBJECT_BETAS, np.zeros(20)])
+        evaluator = PopulationEvaluator(arrays, [target])
+        evaluator.replace_view(anew)
+        np.testing.assert_array_equal(
+            evaluator.evaluate(betas, np.array([pose, pose])).costs,
+            PopulationEvaluator(arrays, [anew]).evaluate(betas, np.array([pose, pose])).costs)
 
 
 def test_photos_through_a_distorting_lens_undistort_to_the_pinhole_photos(body_model,

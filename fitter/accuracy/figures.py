@@ -1,0 +1,91 @@
+"""The accuracy benchmark's figures: error per generation (the paper's Fig. 12) and fitted
+bodies coloured by their distance from the truth (its Figs. 16 and 17).
+
+Both start from a run's run.json files, which record the best candidate's betas after
+every generation (``best_betas_per_generation``), and the set's true bodies.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from bodyfit.fitter.accuracy.scores import IMPORTANT_COLUMNS, KEYS
+from bodyfit.fitter.accuracy.subject_set import read_bodies, subject_ids
+from bodyfit.fitter.body_model import BodyModel, rest_shape
+from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.render import render_colours
+
+__all__ = ["error_per_generation", "distance_panel", "colour_bar", "fitted_rest_body"]
+
+
+def _betas_per_generation(run_folder: Path, subject: str) -> np.ndarray:
+    record = json.loads((Path(run_folder) / subject / "run.json").read_text())
+    return np.array(record["result"]["best_betas_per_generation"], np.float32)
+
+
+def error_per_generation(model: BodyModel, set_folder: Path, run_folder: Path,
+                         generations: list[int]) -> tuple[np.ndarray, int]:
+    """(len(generations),) mean |error| (mm) of the 7 important measurements of the best
+    body so far after each of ``generations`` (1-based), over the run's subjects that
+    have a run.json, and how many those are."""
+    bodies = read_bodies(model, set_folder)
+    measurer = Measurer.from_model(model)
+    ids = subject_ids(len(bodies.sex), bodies.sex)
+    errors, count = [], 0
+    for index, subject in enumerate(ids):
+        if not (Path(run_folder) / subject / "run.json").exists():
+            continue
+        betas = _betas_per_generation(run_folder, subject)
+        picked = betas[np.minimum(generations, len(betas)) - 1]
+        truth = measurer.measure(bodies.vertices[index])
+        rows = []
+        for vertices in rest_shape(model, picked)[0]:
+            measured = measurer.measure(vertices)
+            rows.append([abs(measured[KEYS[j]] - truth[KEYS[j]]) for j in IMPORTANT_COLUMNS])
+        errors.append(np.mean(rows, axis=1))
+        count += 1
+    return np.mean(errors, axis=0), count
+
+
+def fitted_rest_body(model: BodyModel, run_folder: Path, subject: str) -> np.ndarray:
+    """(V, 3) the fitted rest body (the last generation's best) of ``subject``."""
+    return rest_shape(model, _betas_per_generation(run_folder, subject)[-1:])[0][0]
+
+
+def distance_panel(model: BodyModel, truth: np.ndarray, fitted: list[np.ndarray],
+                   height_px: int = 420, top_mm: float = 20.0) -> np.ndarray:
+    """(H, W, 3) BGR: the true rest body in grey, then each fitted body (same topology)
+    coloured by each vertex's distance from its true place after the translation that
+    aligns the two best (their centroids; 0 to ``top_mm`` mm, the colour map's ends),
+    front views at one scale, bottoms level."""
+    grey = np.full((len(model.faces), 3), 170.0)
+    pictures = [render_colours(truth, model.faces, grey, "front", height_px)]
+    for body in fitted:
+        body = body - body.mean(axis=0) + truth.mean(axis=0)  # the best translation
+        distance_mm = 1000 * np.linalg.norm(body - truth, axis=1)
+        level = np.clip(distance_mm[model.faces].mean(axis=1) / top_mm * 255, 0, 255)
+        colours = cv2.applyColorMap(level.astype(np.uint8)[:, None], cv2.COLORMAP_JET)[:, 0]
+        # the same scale as the truth: the fitted body drawn inside the truth's frame
+        scale = np.ptp(body[:, 2]) / np.ptp(truth[:, 2])
+        picture = render_colours(body, model.faces, colours, "front",
+                                 int(round(20 + (height_px - 20) * scale)))
+        pictures.append(picture)
+    height = max(p.shape[0] for p in pictures)
+    padded = [np.vstack([np.full((height - p.shape[0], p.shape[1], 3), 255, np.uint8), p])
+              for p in pictures]
+    return np.hstack(padded)
+
+
+def colour_bar(width_px: int, top_mm: float = 20.0) -> np.ndarray:
+    """(40, width_px, 3) BGR: the colour map of :func:`distance_panel` with its scale."""
+    ramp = np.linspace(0, 255, width_px - 80).astype(np.uint8)[None].repeat(16, axis=0)
+    bar = np.full((40, width_px, 3), 255, np.uint8)
+    bar[4:20, 40:width_px - 40] = cv2.applyColorMap(ramp, cv2.COLORMAP_JET)
+    for mm, x in ((0, 40), (top_mm / 2, width_px // 2), (top_mm, width_px - 40)):
+        cv2.putText(bar, f"{mm:g} mm", (x - 18, 36), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (0, 0, 0),
+                    1, cv2.LINE_AA)
+    return bar

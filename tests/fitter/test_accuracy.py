@@ -1,0 +1,125 @@
+"""The accuracy benchmark: its bodies, photos and statistics against references, and a
+small run of the whole benchmark (tools/bench_accuracy.py) whose report must show a
+working fitter."""
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from scipy import stats
+
+from bodyfit.fitter.accuracy.bodies import draw_bodies, flexion_rotations, pose_bodies
+from bodyfit.fitter.accuracy.photos import PhotoEffects, record
+from bodyfit.fitter.accuracy.report import ISO_ALLOWANCE_MM, iso_verdicts
+from bodyfit.fitter.accuracy.scores import error_stats
+from bodyfit.fitter.body_model import forward, project_shape, rest_shape
+from bodyfit.fitter.model_cache import CACHE_ENV_VAR
+from bodyfit.fitter.side_arms import side_photo_pose
+
+TOOL = Path(__file__).parents[2] / "tools" / "bench_accuracy.py"
+
+
+def test_in_space_bodies_alternate_sexes_and_pose_like_the_model(body_model):
+    bodies = draw_bodies(body_model, "in-space", 6, seed=3)
+    assert list(bodies.sex) == ["female", "male"] * 3
+    again = draw_bodies(body_model, "in-space", 6, seed=3)
+    np.testing.assert_array_equal(bodies.vertices, again.vertices)
+    # in the space: projecting onto 20 components gives the body back
+    betas = project_shape(body_model, bodies.vertices, bodies.joints, 20)
+    np.testing.assert_allclose(rest_shape(body_model, betas)[0], bodies.vertices, atol=2e-5)
+    # no flexion: the model's own forward, front and side (arms down)
+    front, side = pose_bodies(body_model, bodies, 2)
+    np.testing.assert_allclose(front, forward(body_model, betas[2:3], bodies.abduction_deg[2:3])[0],
+                               atol=2e-5)
+    side_pose = side_photo_pose(body_model, betas[2], bodies.abduction_deg[2])
+    np.testing.assert_allclose(side, forward(body_model, betas[2:3], side_pose[None])[0],
+                               atol=2e-5)
+
+
+def test_out_of_space_bodies_are_human_and_outside_the_space(body_model, measurer):
+    bodies = draw_bodies(body_model, "out-of-space", 4, seed=1, pool_per_sex=60)
+    betas = project_shape(body_model, bodies.vertices, bodies.joints, 20)
+    residual = np.abs(rest_shape(body_model, betas)[0] - bodies.vertices).mean(axis=(1, 2))
+    assert np.all(residual > 2e-4)  # at least 0.2 mm per vertex outside the space
+    for vertices in bodies.vertices:
+        assert 1400 < measurer.measure(vertices)["O"] < 2100
+    assert np.all(np.abs(bodies.flexion_deg) <= 4.0) and np.any(bodies.flexion_deg != 0)
+
+
+def test_flexion_swings_a_hanging_limb_forward():
+    rot = flexion_rotations(np.array([[10.0, 0.0, 0.0, 0.0]]))[0, 0]
+    np.testing.assert_allclose(rot @ [0.0, 0.0, -1.0],
+                               [0.0, -np.sin(np.radians(10)), -np.cos(np.radians(10))])
+    np.testing.assert_allclose(rot @ rot.T, np.eye(3), atol=1e-12)
+
+
+def test_recorded_photo_is_a_jpeg_with_the_light_and_noise_asked_for():
+    image = np.full((400, 300, 3), 128, np.uint8)
+    effects = PhotoEffects(light_slope=0.15, vignette=0.0, noise_dn=3.0, jpeg_quality=95)
+    decoded = cv2.imdecode(np.frombuffer(record(image, effects, np.random.default_rng(0)),
+                                         np.uint8), cv2.IMREAD_COLOR)
+    assert decoded.shape == image.shape
+    grey = decoded.astype(float).mean(axis=2)
+    # a linear light slope of at most 15 % each way: the corners differ, within the bound
+    corners = [grey[:20, :20].mean(), grey[-20:, -20:].mean()]
+    assert 128 * 0.7 - 3 < min(corners) and max(corners) < 128 * 1.3 + 3
+    flat = cv2.imdecode(np.frombuffer(record(image, PhotoEffects(0.0, 0.0, 3.0, 100),
+                                             np.random.default_rng(1)), np.uint8),
+                        cv2.IMREAD_COLOR)
+    assert 2.0 < flat.astype(float).std() < 4.0  # the sensor noise, through the JPEG
+
+
+def test_error_stats_agree_with_scipy():
+    rng = np.random.default_rng(0)
+    errors = rng.normal(1.0, 3.0, (50, 3))
+    spreads = np.full((50, 3), 3.0)
+    s = error_stats(errors, spreads)
+    lo, hi = stats.t.interval(0.95, 49, loc=errors[:, 0].mean(), scale=stats.sem(errors[:, 0]))
+    assert s.bias[0] == pytest.approx((lo + hi) / 2) and s.bias_ci[0] == pytest.approx((hi - lo) / 2)
+    lo, hi = stats.t.interval(0.95, 49, loc=np.abs(errors[:, 1]).mean(),
+                              scale=stats.sem(np.abs(errors[:, 1])))
+    assert s.mae_ci[1] == pytest.approx((hi - lo) / 2)
+    assert s.covered[2] == pytest.approx(np.mean(np.abs(errors[:, 2]) <= 3.0))
+    with pytest.raises(ValueError, match="at least 2"):
+        error_stats(errors[:1])
+
+
+def test_iso_verdict_is_the_bias_interval_inside_the_allowance():
+    errors = np.zeros((40, 16))
+    errors[:, 3] = 8.0 + np.tile([-0.1, 0.1], 20)  # chest: +8 mm, tight: inside 9 mm
+    errors[:, 0] = 4.5  # head: +4.5 mm, outside 4 mm
+    verdicts = iso_verdicts(error_stats(errors))
+    assert ISO_ALLOWANCE_MM["D"] == 9 and verdicts["D"] == "pass"
+    assert ISO_ALLOWANCE_MM["A"] == 4 and verdicts["A"] == "fail"
+    assert verdicts["B"] == "pass"
+
+
+def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
+    """4 in-space subjects, a small budget: calib capture, fitter batch, the report."""
+    env = dict(os.environ, **{CACHE_ENV_VAR: str(tmp_path / "cache")})
+    subject_set = tmp_path / "set"
+
+    def tool(*args):
+        return subprocess.run([sys.executable, str(TOOL), *args], env=env, check=True,
+                              capture_output=True, text=True).stdout
+
+    tool("make", str(subject_set), "--kind", "in-space", "--count", "4", "--seed", "2",
+         "--workers", "2")
+    assert len((subject_set / "subjects.csv").read_text().splitlines()) == 5
+    tool("fit", str(subject_set), "small", "--", "--generations", "60")
+    assert (subject_set / "camera.json").exists()
+    report = tool("report", "--main", f"small=set:{subject_set}:small".replace("set:", "", 1))
+    row = next(line for line in report.splitlines() if line.startswith("| small |"))
+    cells = [cell.strip() for cell in row.split("|")[1:-1]]
+    assert cells[1:3] == ["4", "0"]  # 4 fitted, none failed
+    mean7 = float(re.search(r"\*\*([\d.]+)\*\*", cells[-1]).group(1))
+    # loose: 60 generations through a calibrated phone camera give about 10 mm; a broken
+    # fitter gives tens of millimetres
+    assert mean7 < 20.0
+    stature = next(line for line in report.splitlines() if line.startswith("| O stature"))
+    assert float(stature.split("|")[2].split("±")[0]) < 1.0  # the stature is given
