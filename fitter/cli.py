@@ -34,8 +34,9 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                             help="repeat a previous run: its inputs and settings from its "
                                  "run.json (the options given here override them)")
     parser.add_argument("--method", choices=("bodyfit", "paper"),
-                        help="bodyfit (default: CMA-ES 30 x 200, stature-conditioned "
-                             "candidates, symmetric matching, bodyfit weights) or paper (the "
+                        help="bodyfit (default: CMA-ES 30 x 150, stature-conditioned "
+                             "candidates, symmetric matching, bodyfit weights, the camera placed "
+                             "anew from the best body) or paper (the "
                              "paper's method exactly: its GA 30 x 25, Table 2 weights, "
                              "person-to-model matching); the options below override single "
                              "settings")

@@ -168,7 +168,9 @@ def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, set
     ``settings.placement_rounds`` evenly spaced generations; it updates ``views`` too."""
     generations = settings.search.generations or 1
     rounds = settings.placement_rounds
-    at = {round(generations * (i + 1) / (rounds + 1)) for i in range(rounds)}
+    # never after the last generation: its best must be scored with the cameras it ends with
+    at = {g for g in (round(generations * (i + 1) / (rounds + 1)) for i in range(rounds))
+          if 1 <= g < generations}
 
     def place(done: int, betas: np.ndarray, pose_deg: np.ndarray) -> bool:
         if done not in at:

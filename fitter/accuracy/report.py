@@ -103,7 +103,7 @@ def iso_verdicts(s: ErrorStats) -> dict[str, str]:
 
 
 def failure_lines(scores: RunScores) -> list[str]:
-    """The failures counted by reason (a reason's subject-specific path left out)."""
-    reasons = collections.Counter(reason.split(": ", 1)[-1] if reason.startswith("/")
-                                  else reason for _, reason in scores.failures)
+    """The failures counted by reason, each subject's id in its reason written ``<id>``."""
+    reasons = collections.Counter(reason.replace(subject, "<id>")
+                                  for subject, reason in scores.failures)
     return [f"- {count} x {reason}" for reason, count in reasons.most_common()]

@@ -123,3 +123,15 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert mean7 < 20.0
     stature = next(line for line in report.splitlines() if line.startswith("| O stature"))
     assert float(stature.split("|")[2].split("±")[0]) < 1.0  # the stature is given
+
+
+def test_failures_are_counted_by_reason():
+    from bodyfit.fitter.accuracy.report import failure_lines
+    from bodyfit.fitter.accuracy.scores import RunScores
+
+    scores = RunScores([], np.zeros((0, 16)), np.zeros((0, 16)), np.zeros(0),
+                       [("s1", "no person found in /x/s1/front.jpg"),
+                        ("s2", "no person found in /x/s2/front.jpg"),
+                        ("s3", "the person is cut off by the frame")], np.zeros(0, bool))
+    assert failure_lines(scores) == ["- 2 x no person found in /x/<id>/front.jpg",
+                                     "- 1 x the person is cut off by the frame"]

@@ -188,6 +188,25 @@ def test_run_with_camera_writes_its_outputs(body_model, tmp_path, capsys):
     assert abs(stature["value_mm"] - truth["O"]) < 40.0
 
 
+@pytest.mark.parametrize("generations, rounds", [(1, 2), (2, 2), (6, 4)])
+def test_placement_rounds_never_end_the_search(body_model, tmp_path, capsys, generations,
+                                               rounds):
+    """However few the generations, the cameras are never placed anew after the last one
+    (its best would go unscored); the rounds show as forgotten bests (costs that rise)."""
+    truth = write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, SUBJECT_POSE, K_TRUE,
+                                  SIZE_PX, 2.8, 1.1)
+    out = tmp_path / "out"
+    code = main(["-q", "run", "--front", str(tmp_path / "front.png"), "--side",
+                 str(tmp_path / "side.png"), "--height-cm", f"{truth['O'] / 10:.2f}",
+                 "--camera", str(tmp_path / "camera.json"), "-o", str(out), "--population",
+                 "8", "--generations", str(generations), "--placement-rounds", str(rounds)])
+    assert code == 0, capsys.readouterr().err
+    record = json.loads((out / "run.json").read_text())
+    assert record["settings"]["placement_rounds"] == rounds
+    best = np.array(record["result"]["best_cost_per_generation"])
+    assert np.all(np.isfinite(best)) and len(best) == generations
+
+
 def test_a_camera_of_another_size_is_refused(body_model, tmp_path, capsys):
     write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, SUBJECT_POSE, K_TRUE, SIZE_PX,
                           3.0, 1.2)
