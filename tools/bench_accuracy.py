@@ -11,6 +11,9 @@
     # Markdown tables (docs/accuracy.md holds them)
     python tools/bench_accuracy.py report --main "in-space=SETS/in:default" \
         --ablation "uniform weights=SETS/in:uniform-weights"
+    # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
+    python tools/bench_accuracy.py figures SETS/in --curve "bodyfit=default" \
+        --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
 
 ``make --bodies-only`` stops after drawing the bodies (bodies.npz, set.json: the
 out-of-space draw needs Anny, the photos do not), ``make`` again photographs them; a set
@@ -22,7 +25,6 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
-import csv
 import dataclasses
 import json
 import multiprocessing
@@ -100,12 +102,6 @@ def fit(args, batch_options: list[str]) -> None:
     if args.first:  # the table's first rows: as many women as men (subject_set's order)
         lines = lines[:args.first + 1]
         table = folder / f"subjects-first{args.first}.csv"
-    if args.rest_of:  # the subjects another run has not fitted (a run continued elsewhere)
-        with open(folder / "runs" / args.rest_of / "summary.csv", newline="") as file:
-            done = {row["id"] for row in csv.DictReader(file)
-                    if row["status"] in ("fitted", "fitted earlier")}
-        lines = [lines[0], *(line for line in lines[1:] if line.split(",")[0] not in done)]
-        table = folder / f"subjects-rest-of-{args.rest_of}.csv"
     if table != folder / "subjects.csv":
         table.write_text("".join(lines))
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
@@ -127,50 +123,37 @@ def fit(args, batch_options: list[str]) -> None:
     print(f"{out}: fitter batch exit {code} in {wall:.0f} s")
 
 
-def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
-    """LABEL=SET:NAME[+NAME2...] -> (label, the set, its runs' folders)."""
+def _run_spec(spec: str) -> tuple[str, Path, Path]:
+    """LABEL=SET:NAME -> (label, the set, the run's folder)."""
     label, _, where = spec.partition("=")
-    set_folder, _, names = where.rpartition(":")
-    return label, Path(set_folder), [Path(set_folder) / "runs" / n for n in names.split("+")]
+    set_folder, _, name = where.rpartition(":")
+    return label, Path(set_folder), Path(set_folder) / "runs" / name
 
 
-def _scores(set_folder: Path, runs: list[Path]):
-    """The runs' scores as one run's (runs that share no subject)."""
-    parts = [read_scores(set_folder, run) for run in runs]
-    return dataclasses.replace(
-        parts[0], ids=[i for p in parts for i in p.ids],
-        **{field: np.concatenate([getattr(p, field) for p in parts])
-           for field in ("errors", "spreads", "seconds", "hard")},
-        failures=[f for p in parts for f in p.failures])
-
-
-def _timing(scores, runs: list[Path]) -> str:
-    lines = []
-    for run in runs:
-        if not (run / "batch.json").exists():  # fitter batch was stopped before its end
-            lines.append(f"{run.name}: stopped before its end, no timing recorded")
-            continue
-        record = json.loads((run / "bench.json").read_text())["runs"]
-        batch = json.loads((run / "batch.json").read_text())
-        fitted = batch["subjects"]["fitted"]
-        wall = batch["seconds"]["total"]
-        lines.append(f"{fitted} subjects in {wall:.0f} s wall ({wall / max(fitted, 1):.2f} s "
-                     f"per subject, {batch['workers']} workers, "
-                     f"{' '.join(record[0]['command'][5:])}) on {record[-1]['machine']}; peak "
-                     f"memory of one process {max(r['peak_rss_mb'] for r in record)} MB")
+def _timing(scores, run: Path) -> str:
+    """Where and how fast the run went, from its batch.json and bench.json."""
+    if not (run / "batch.json").exists():  # fitter batch was stopped before its end
+        return f"{len(scores.ids)} fitted; stopped before its end, no timing recorded"
+    record = json.loads((run / "bench.json").read_text())["runs"]
+    batch = json.loads((run / "batch.json").read_text())
+    fitted, wall = batch["subjects"]["fitted"], batch["seconds"]["total"]
     return (f"{len(scores.ids)} fitted, {len(scores.failures)} failed; each subject's job "
-            f"(photos to written results) {np.nanmedian(scores.seconds):.1f} s median; "
-            + "; ".join(lines))
+            f"(photos to written results) {np.nanmedian(scores.seconds):.1f} s median; the "
+            f"last batch fitted {fitted} in {wall:.0f} s wall ({wall / max(fitted, 1):.2f} s "
+            f"per subject, {batch['workers']} workers, "
+            f"`fitter batch {' '.join(record[-1]['command'][3:])}`) on "
+            f"{record[-1]['machine']}; peak memory of one process "
+            f"{max(r['peak_rss_mb'] for r in record)} MB")
 
 
 def report(args) -> None:
     mains = [_run_spec(spec) for spec in args.main]
     ablations = [_run_spec(spec) for spec in args.ablation]
     table4 = {}
-    for label, set_folder, runs in mains:
-        scores = _scores(set_folder, runs)
+    for label, set_folder, run in mains:
+        scores = read_scores(set_folder, run)
         table4[label] = scores
-        print(f"### {label}\n\n{_timing(scores, runs)}.\n")
+        print(f"### {label}\n\n{_timing(scores, run)}.\n")
         print("\n".join(measurement_table(scores)) + "\n")
         if 2 <= scores.hard.sum() <= len(scores.hard) - 2:
             print("Out-of-space hard share alone: " + important_table(
@@ -178,10 +161,10 @@ def report(args) -> None:
                  "the others": _subset(scores, ~scores.hard)})[2].split("|", 2)[2] + "\n")
         if scores.failures:
             print("Failures:\n\n" + "\n".join(failure_lines(scores)) + "\n")
-    for label, set_folder, runs in ablations:
-        scores = _scores(set_folder, runs)
+    for label, set_folder, run in ablations:
+        scores = read_scores(set_folder, run)
         table4[label] = scores
-        print(f"- {label}: {_timing(scores, runs)}")
+        print(f"- {label}: {_timing(scores, run)}")
     print("\n### The 7 important measurements (Table 4 form)\n")
     print("\n".join(important_table(table4)))
 
@@ -251,8 +234,6 @@ def main() -> None:
     p.add_argument("name", help="the run's name (SET/runs/NAME)")
     p.add_argument("--camera", choices=("calibrated", "none"), default="calibrated",
                    help="none: fitter batch without --camera (a typical phone assumed)")
-    p.add_argument("--rest-of", metavar="RUN", help="fit only the subjects the run RUN of "
-                   "this set has not fitted (RUN's summary.csv); report both as RUN+NAME")
     p.add_argument("--first", type=int, help="fit only the set's first N subjects (N even: "
                    "half women, half men)")
     p = sub.add_parser("report", help="Markdown tables of runs")
@@ -272,7 +253,10 @@ def main() -> None:
     argv = sys.argv[1:]
     batch_options = argv[argv.index("--") + 1:] if "--" in argv else []
     args = parser.parse_args(argv[:argv.index("--")] if "--" in argv else argv)
-    {"make": make, "report": report, "figures": figures}.get(args.command, lambda a: fit(a, batch_options))(args)
+    if args.command == "fit":
+        fit(args, batch_options)
+    else:
+        {"make": make, "report": report, "figures": figures}[args.command](args)
 
 
 if __name__ == "__main__":

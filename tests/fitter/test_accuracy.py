@@ -80,7 +80,8 @@ def test_error_stats_agree_with_scipy():
     spreads = np.full((50, 3), 3.0)
     s = error_stats(errors, spreads)
     lo, hi = stats.t.interval(0.95, 49, loc=errors[:, 0].mean(), scale=stats.sem(errors[:, 0]))
-    assert s.bias[0] == pytest.approx((lo + hi) / 2) and s.bias_ci[0] == pytest.approx((hi - lo) / 2)
+    assert s.bias[0] == pytest.approx((lo + hi) / 2)
+    assert s.bias_ci[0] == pytest.approx((hi - lo) / 2)
     lo, hi = stats.t.interval(0.95, 49, loc=np.abs(errors[:, 1]).mean(),
                               scale=stats.sem(np.abs(errors[:, 1])))
     assert s.mae_ci[1] == pytest.approx((hi - lo) / 2)
