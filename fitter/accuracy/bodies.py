@@ -15,10 +15,13 @@ Two kinds (``KINDS``):
   its data cache (about 1.1 GB, built on first use).
 
 Poses: the front photo's four abduction angles are drawn uniformly from ``abduction_deg``;
-out-of-space bodies also bend each limb forward or back by up to ``flexion_deg``, a
-motion the model's rig cannot make. The side photo hangs the arms down (shoulders at the
-body's own arms-down angle, :func:`~bodyfit.fitter.side_arms.arms_down_angle`), the legs
-and the flexion as in the front photo.
+out-of-space bodies also bend each limb forward or back by up to ``flexion_deg`` in the
+front photo, a motion the model's rig cannot make. The side photo hangs the arms down
+(shoulders at the body's own arms-down angle,
+:func:`~bodyfit.fitter.side_arms.arms_down_angle`), the legs at the front photo's
+abduction, no flexion (the issue's protocol: angles varied in the front photo, the arms
+down in the side photo; legs bent differently in a side photo would show as thicker
+calves and thighs).
 
 Units: metres, model frame (z up, -y forward); degrees.
 """
@@ -157,14 +160,14 @@ def flexion_rotations(flexion_deg: np.ndarray) -> np.ndarray:
 
 def pose_bodies(model: BodyModel, bodies: Bodies, index: int) -> tuple[np.ndarray, np.ndarray]:
     """(front, side) posed vertices (V, 3) float32 of body ``index``: the front photo's
-    pose, and the side photo's (arms hanging down)."""
+    pose (abduction and flexion), and the side photo's (arms hanging down, no flexion)."""
     rest, joints = bodies.vertices[index], bodies.joints[index]
     front = bodies.abduction_deg[index].astype(float)
     side = front.copy()
     side[:2] = arms_down_angle(model, rest, joints)
     flex = flexion_rotations(bodies.flexion_deg[index][None])
     rotations = np.concatenate([abduction_rotations(front[None]) @ flex,
-                                abduction_rotations(side[None]) @ flex])
+                                abduction_rotations(side[None])])
     posed = blend_skinning(model.chain_weights, np.stack([rest, rest]),
                            np.stack([joints, joints]), rotations)
     return posed[0], posed[1]
