@@ -2,6 +2,7 @@
 small run of the whole benchmark (tools/bench_accuracy.py) whose report must show a
 working fitter."""
 
+import dataclasses
 import os
 import re
 import subprocess
@@ -39,6 +40,11 @@ def test_in_space_bodies_alternate_sexes_and_pose_like_the_model(body_model):
     side_pose = side_photo_pose(body_model, betas[2], bodies.abduction_deg[2])
     np.testing.assert_allclose(side, forward(body_model, betas[2:3], side_pose[None])[0],
                                atol=2e-5)
+    # limbs bent: the front photo only
+    bent = dataclasses.replace(bodies, flexion_deg=np.full((6, 4), 4.0))
+    bent_front, bent_side = pose_bodies(body_model, bent, 2)
+    np.testing.assert_array_equal(bent_side, side)
+    assert np.abs(bent_front - front).max() > 0.02  # the hands move by centimetres
 
 
 def test_out_of_space_bodies_are_human_and_outside_the_space(body_model, measurer):
