@@ -189,8 +189,8 @@ def figures(args) -> None:
         curves[label], counts[label] = error_per_generation(model, folder, run, generations)
         print(f"{label}: {counts[label]} subjects; " + ", ".join(
             f"g{g} {e:.1f}" for g, e in zip(generations, curves[label])))
-    chart = line_chart(curves, f"{args.title}: best body so far", "generation",
-                       "7 important measurements, mean abs. error (mm)", log_y=True,
+    chart = line_chart(curves, f"{args.title}: the best so far", "generation",
+                       "7 important, mean abs. error (mm)",
                        x_values={label: generations for label in curves})
     write_image(Path(args.docs) / "accuracy_error_per_generation.png", chart)
     bodies = read_bodies(model, folder)
@@ -248,7 +248,7 @@ def main() -> None:
     p.add_argument("--meshes", nargs="+", default=[], metavar="LABEL",
                    help="the curves' runs whose fitted bodies are drawn")
     p.add_argument("--generations", type=int, default=150)
-    p.add_argument("--title", default="in-space subjects")
+    p.add_argument("--title", default="in-space")
     p.add_argument("--docs", default="docs")
     argv = sys.argv[1:]
     batch_options = argv[argv.index("--") + 1:] if "--" in argv else []
