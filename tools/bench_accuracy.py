@@ -183,20 +183,22 @@ def figures(args) -> None:
     runs = {label: folder / "runs" / name for label, name in
             (spec.split("=", 1) for spec in args.curve)}
     generations = [g for g in (1, 2, 3, 5, 8, 12, 18, 25, 35, 50, 70, 100, 125, 150, 200)
-                   if g <= args.generations]
-    curves, counts = {}, {}
+                   if g < args.generations] + [args.generations]
+    bodies = read_bodies(model, folder)
+    ids = subject_ids(len(bodies.sex), bodies.sex)
+    common = {s for s in ids if all((run / s / "run.json").exists() for run in runs.values())}
+    curves = {}
     for label, run in runs.items():
-        curves[label], counts[label] = error_per_generation(model, folder, run, generations)
-        print(f"{label}: {counts[label]} subjects; " + ", ".join(
-            f"g{g} {e:.1f}" for g, e in zip(generations, curves[label])))
-    chart = line_chart(curves, f"{args.title}: the best so far", "generation",
+        curves[label] = error_per_generation(model, folder, run, generations, common)
+        print(f"{label}: " + ", ".join(f"g{g} {e:.1f}" for g, e in zip(generations,
+                                                                      curves[label])))
+    chart = line_chart(curves, f"{args.title}, {len(common)} subjects: the best so far",
+                       "generation",
                        "7 important, mean abs. error (mm)",
                        x_values={label: generations for label in curves})
     write_image(Path(args.docs) / "accuracy_error_per_generation.png", chart)
-    bodies = read_bodies(model, folder)
-    ids = subject_ids(len(bodies.sex), bodies.sex)
     shown = [runs[label] for label in args.meshes]
-    candidates = [i for i, s in enumerate(ids) if all((r / s / "run.json").exists() for r in shown)]
+    candidates = [i for i, s in enumerate(ids) if s in common]
     measurer = Measurer.from_model(model)
     waist = np.array([measurer.measure(bodies.vertices[i])["E"] for i in candidates])
     rows = []
@@ -205,8 +207,9 @@ def figures(args) -> None:
         panel = distance_panel(model, bodies.vertices[index],
                                [fitted_rest_body(model, run, ids[index]) for run in shown])
         caption = np.full((28, panel.shape[1], 3), 255, np.uint8)
-        cv2.putText(caption, f"{name}: {ids[index]}, waist {waist[candidates.index(index)]:.0f} mm"
-                    f" - truth | " + " | ".join(args.meshes), (8, 20),
+        label = (f"{name}: {ids[index]}, waist {waist[candidates.index(index)]:.0f} mm - "
+                 "truth | " + " | ".join(args.meshes))
+        cv2.putText(caption, label, (8, 20),
                     cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
         rows.append(np.vstack([caption, panel]))
     width = max(r.shape[1] for r in rows)

@@ -17,43 +17,50 @@ from bodyfit.fitter.accuracy.scores import IMPORTANT_COLUMNS, KEYS
 from bodyfit.fitter.accuracy.subject_set import read_bodies, subject_ids
 from bodyfit.fitter.body_model import BodyModel, rest_shape
 from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.stature import stature_scale
 from bodyfit.fitter.render import render_colours
 
 __all__ = ["error_per_generation", "distance_panel", "colour_bar", "fitted_rest_body"]
 
 
-def _betas_per_generation(run_folder: Path, subject: str) -> np.ndarray:
+def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
+                 generations: list[int] | None = None) -> np.ndarray:
+    """(G, V, 3) the best rest body so far after each of ``generations`` (1-based; None:
+    the last), as the fit measures it: stood as tall as the person when the run solved
+    every candidate to the stature (``fitter.fit.fit_person``)."""
     record = json.loads((Path(run_folder) / subject / "run.json").read_text())
-    return np.array(record["result"]["best_betas_per_generation"], np.float32)
+    betas = np.array(record["result"]["best_betas_per_generation"], np.float32)
+    picked = betas[np.minimum(generations or [len(betas)], len(betas)) - 1]
+    rest = rest_shape(model, picked)[0]
+    if record["settings"]["search"]["condition_stature"]:
+        stature_m = record["inputs"]["height_cm"] / 100.0
+        rest = np.stack([body * stature_scale(body, stature_m) for body in rest])
+    return rest
 
 
 def error_per_generation(model: BodyModel, set_folder: Path, run_folder: Path,
-                         generations: list[int]) -> tuple[np.ndarray, int]:
+                         generations: list[int], subjects: set[str]) -> np.ndarray:
     """(len(generations),) mean |error| (mm) of the 7 important measurements of the best
-    body so far after each of ``generations`` (1-based), over the run's subjects that
-    have a run.json, and how many those are."""
+    body so far after each of ``generations`` (1-based), over ``subjects`` (ids whose
+    run.json the run has); the last generation's is the run's own error."""
     bodies = read_bodies(model, set_folder)
     measurer = Measurer.from_model(model)
-    ids = subject_ids(len(bodies.sex), bodies.sex)
-    errors, count = [], 0
-    for index, subject in enumerate(ids):
-        if not (Path(run_folder) / subject / "run.json").exists():
+    errors = []
+    for index, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex)):
+        if subject not in subjects:
             continue
-        betas = _betas_per_generation(run_folder, subject)
-        picked = betas[np.minimum(generations, len(betas)) - 1]
         truth = measurer.measure(bodies.vertices[index])
         rows = []
-        for vertices in rest_shape(model, picked)[0]:
+        for vertices in _rest_bodies(model, run_folder, subject, generations):
             measured = measurer.measure(vertices)
             rows.append([abs(measured[KEYS[j]] - truth[KEYS[j]]) for j in IMPORTANT_COLUMNS])
         errors.append(np.mean(rows, axis=1))
-        count += 1
-    return np.mean(errors, axis=0), count
+    return np.mean(errors, axis=0)
 
 
 def fitted_rest_body(model: BodyModel, run_folder: Path, subject: str) -> np.ndarray:
-    """(V, 3) the fitted rest body (the last generation's best) of ``subject``."""
-    return rest_shape(model, _betas_per_generation(run_folder, subject)[-1:])[0][0]
+    """(V, 3) the fitted rest body of ``subject`` (the last generation's best)."""
+    return _rest_bodies(model, run_folder, subject)[0]
 
 
 def distance_panel(model: BodyModel, truth: np.ndarray, fitted: list[np.ndarray],

@@ -130,6 +130,13 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert mean7 < 20.0
     stature = next(line for line in report.splitlines() if line.startswith("| O stature"))
     assert float(stature.split("|")[2].split("±")[0]) < 1.0  # the stature is given
+    # Fig. 12: the error after the last generation is the run's own error (round trip)
+    printed = tool("figures", str(subject_set), "--curve", "small=small", "--meshes", "small",
+                   "--generations", "60", "--docs", str(tmp_path))
+    last = float(re.search(r"g60 ([\d.]+)", printed).group(1))
+    assert last == pytest.approx(mean7, abs=0.06)
+    for name in ("accuracy_error_per_generation.png", "accuracy_meshes.png"):
+        assert cv2.imread(str(tmp_path / name)) is not None
 
 
 def test_failures_are_counted_by_reason():
