@@ -156,24 +156,30 @@ def report(args) -> None:
         print(f"### {label}\n\n{_timing(scores, run)}.\n")
         print("\n".join(measurement_table(scores)) + "\n")
         if 2 <= scores.hard.sum() <= len(scores.hard) - 2:
-            split = important_table({"the hard share (wider start)": _subset(scores, scores.hard),
-                                     "the others": _subset(scores, ~scores.hard)})
+            hard = {i for i, h in zip(scores.ids, scores.hard) if h}
+            split = important_table({"the hard share (wider start)": _subset(scores, hard),
+                                     "the others": _subset(scores, set(scores.ids) - hard)})
             print("\n".join(split[:-1]) + "\n")  # without the paper's row
         if scores.failures:
             print("Failures:\n\n" + "\n".join(failure_lines(scores)) + "\n")
     for label, set_folder, run in ablations:
         scores = read_scores(set_folder, run)
+        if args.first:  # the set's first N subjects (those of `fit --first N`)
+            rows = (set_folder / "subjects.csv").read_text().splitlines()[1:args.first + 1]
+            scores = _subset(scores, {row.split(",")[0] for row in rows})
         table4[label] = scores
         print(f"- {label}: {_timing(scores, run)}")
     print("\n### The 7 important measurements (Table 4 form)\n")
     print("\n".join(important_table(table4)))
 
 
-def _subset(scores, keep):
-    return dataclasses.replace(scores, ids=[i for i, k in zip(scores.ids, keep) if k],
+def _subset(scores, ids: set[str]):
+    """The scores of the subjects ``ids`` (fitted or failed) only."""
+    keep = np.array([i in ids for i in scores.ids], bool)
+    return dataclasses.replace(scores, ids=[i for i in scores.ids if i in ids],
                                errors=scores.errors[keep], spreads=scores.spreads[keep],
                                seconds=scores.seconds[keep], hard=scores.hard[keep],
-                               failures=[])
+                               failures=[f for f in scores.failures if f[0] in ids])
 
 
 def figures(args) -> None:
@@ -244,6 +250,8 @@ def main() -> None:
                    help="a run with its full Table 3 form")
     p.add_argument("--ablation", action="append", default=[], metavar="LABEL=SET:NAME",
                    help="a run in the Table 4 form only")
+    p.add_argument("--first", type=int, help="the ablations' rows over their set's first N "
+                   "subjects only (compare runs of `fit --first N` with a full run)")
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
