@@ -90,6 +90,8 @@ def _command(name: str) -> str:
 
 def fit(args, batch_options: list[str]) -> None:
     folder = Path(args.set)
+    if not (folder / "subjects.csv").exists():
+        sys.exit(f"{folder}: not a subject set (no subjects.csv); make it with `make` first")
     camera = folder / "camera.json"
     if args.camera == "calibrated" and not camera.exists():
         photos = sorted(str(p) for p in (folder / "board").glob("*.png"))
@@ -195,7 +197,7 @@ def figures(args) -> None:
     common = {s for s in ids if all((run / s / "run.json").exists() for run in runs.values())}
     curves = {}
     for label, run in runs.items():
-        curves[label] = error_per_generation(model, folder, run, generations, common)
+        curves[label] = error_per_generation(model, bodies, run, generations, common)
         print(f"{label}: " + ", ".join(f"g{g} {e:.1f}" for g, e in zip(generations,
                                                                       curves[label])))
     chart = line_chart(curves, f"{args.title}, {len(common)} subjects: the best so far",

@@ -14,7 +14,8 @@ import cv2
 import numpy as np
 
 from bodyfit.fitter.accuracy.scores import IMPORTANT_COLUMNS, KEYS
-from bodyfit.fitter.accuracy.subject_set import read_bodies, subject_ids
+from bodyfit.fitter.accuracy.bodies import Bodies
+from bodyfit.fitter.accuracy.subject_set import subject_ids
 from bodyfit.fitter.body_model import BodyModel, rest_shape
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.stature import stature_scale
@@ -38,12 +39,12 @@ def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
     return rest
 
 
-def error_per_generation(model: BodyModel, set_folder: Path, run_folder: Path,
+def error_per_generation(model: BodyModel, bodies: Bodies, run_folder: Path,
                          generations: list[int], subjects: set[str]) -> np.ndarray:
     """(len(generations),) mean |error| (mm) of the 7 important measurements of the best
     body so far after each of ``generations`` (1-based), over ``subjects`` (ids whose
-    run.json the run has); the last generation's is the run's own error."""
-    bodies = read_bodies(model, set_folder)
+    run.json the run has); ``bodies``: the set's (:func:`.subject_set.read_bodies`); the
+    last generation's is the run's own error."""
     measurer = Measurer.from_model(model)
     errors = []
     for index, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex)):
