@@ -33,7 +33,7 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel, forward
 from bodyfit.kernels.view_camera import camera_matrices
 
-__all__ = ["CanvasSettings", "extreme_bodies", "orthographic_view", "scaled_person"]
+__all__ = ["CanvasSettings", "PAPER_CANVAS", "extreme_bodies", "orthographic_view", "scaled_person"]
 
 #: The parts each view renders: the side photo is taken with the arms hanging against
 #: the body, which the model's four pose angles cannot reproduce (kernels.SIDE_VIEW_PARTS).
@@ -46,19 +46,26 @@ class CanvasSettings:
     """Canvas geometry.
 
     Attributes:
-        body_height_px: the person's height on the canvas, pixels (the paper's canvases
-            are 512 px high; 400 px of body leaves room for taller candidates).
+        body_height_px: the person's height on the canvas, pixels. 600 (bodyfit's
+            default): about a phone photo's own resolution of a person 2.5-3.5 m away;
+            400 missed the 7 important measurements by 5.1 mm against 3.6 at 600 and 800
+            (docs/accuracy.md, "Pushing the numbers"). The paper's canvases are 512 px high
+            (:data:`PAPER_CANVAS`: 400 px of body leaves room for taller candidates).
         margin_px: free pixels around the largest candidate.
         beta_limit: shape coefficients span +-this many standard deviations.
     """
 
-    body_height_px: int = 400
+    body_height_px: int = 600
     margin_px: int = 6
     beta_limit: float = 3.0
 
     def validate(self) -> None:
         if not 32 <= self.body_height_px <= 2048:
             raise UserError(f"the canvas body height must be 32-2048 px, got {self.body_height_px}")
+
+
+#: The paper's canvas: 512 px high, the person 400 px of it (``--method paper``).
+PAPER_CANVAS = CanvasSettings(body_height_px=400)
 
 
 def extreme_bodies(model: BodyModel, num_betas: int, pose_lower, pose_upper,

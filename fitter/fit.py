@@ -19,7 +19,7 @@ from threadpoolctl import threadpool_limits
 from bodyfit import kernels
 from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, BodyModel, forward, rest_shape
-from bodyfit.fitter.canvas import CanvasSettings, extreme_bodies, orthographic_view
+from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
@@ -90,12 +90,13 @@ class FitSettings:
 #: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
 #: docs/fitter.md "Choosing the defaults") and the paper's method exactly (Sections
 #: 3.3-3.4): its GA at 30 x 25 over all 20 betas and the 4 angles, Table 2's weights, the
-#: person -> model matching, the moments' alignment.
+#: person -> model matching, the moments' alignment, its 512 px canvases.
 METHODS = {
     "bodyfit": FitSettings(),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False),
-                         cost=kernels.CostSettings(), projection="orthographic",
+                         canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
+                         projection="orthographic",
                          render_cell_mm=0.0, placement_rounds=0),
 }
 

@@ -11,7 +11,7 @@ from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import to_upright
 from bodyfit.fitter.body_model import PART_NAMES, forward
-from bodyfit.fitter.canvas import VIEW_PARTS, extreme_bodies
+from bodyfit.fitter.canvas import VIEW_PARTS, CanvasSettings, extreme_bodies
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.pinhole_canvas import (Placement, phone_intrinsics, pinhole_view,
                                            placed_anew, solve_placement, upright_intrinsics)
@@ -95,7 +95,7 @@ def test_a_body_point_lands_where_the_photo_has_it(body_model, mean_body):
         assert np.abs(via_canvas - expected).max() < 0.5, view
         # the canvas holds the person body_height_px tall, the scale at the person's distance
         rows = np.flatnonzero(target.boundary_distance.numpy().min(axis=1) == 0)
-        assert abs(rows[-1] - rows[0] + 1 - 400) <= 1
+        assert abs(rows[-1] - rows[0] + 1 - CanvasSettings().body_height_px) <= 1
         assert target.millimetres_per_pixel == pytest.approx(
             1000 * truth.distance_m / k_canvas[1, 1], rel=0.002)
 

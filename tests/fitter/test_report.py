@@ -61,9 +61,10 @@ def first_run(body_model, tmp_path_factory):
 @pytest.mark.parametrize("view", ["front", "side"])
 def test_overlays_show_both_silhouettes_and_part_coloured_pairs(first_run, view):
     image = cv2.imread(str(first_run / f"overlay_{view}.png"))
-    # twice the canvas, cropped to the bodies (about 400 px tall there) with 16 px around,
-    # under a 30 px title band
-    assert abs(image.shape[0] - (2 * 400 + 2 * 16 + 30)) <= 2 * 15
+    # twice the canvas, cropped to the bodies (about as tall as the canvas's person there)
+    # with 16 px around, under a 30 px title band
+    body_px = FitSettings().canvas.body_height_px
+    assert abs(image.shape[0] - (2 * body_px + 2 * 16 + 30)) <= 2 * 15
     drawing = image[30:, :-120]  # the legend is the last 120 columns
     counts = {name: int((drawing == colour).all(axis=2).sum())
               for name, colour in zip(PART_NAMES, PART_COLOURS_BGR)}
