@@ -164,7 +164,11 @@ def report(args) -> None:
             print("\n".join(split[:-1]) + "\n")  # without the paper's row
         if scores.failures:
             print("Failures:\n\n" + "\n".join(failure_lines(scores)) + "\n")
+    baselines, first_of_set = {}, {}  # each ablation is paired with its set's first row
     for label, set_folder, run in ablations:
+        baseline = first_of_set.setdefault(set_folder.resolve(), label)
+        if baseline != label:
+            baselines[label] = baseline
         scores = read_scores(set_folder, run)
         if args.first:  # the set's first N subjects (those of `fit --first N`)
             rows = (set_folder / "subjects.csv").read_text().splitlines()[1:args.first + 1]
@@ -172,7 +176,7 @@ def report(args) -> None:
         table4[label] = scores
         print(f"- {label}: {_timing(scores, run)}")
     print("\n### The 7 important measurements (Table 4 form)\n")
-    print("\n".join(important_table(table4)))
+    print("\n".join(important_table(table4, baselines)))
 
 
 def _subset(scores, ids: set[str]):

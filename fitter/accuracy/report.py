@@ -20,7 +20,8 @@ from bodyfit.fitter.accuracy.scores import (IMPORTANT_COLUMNS, KEYS, ErrorStats,
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 
 __all__ = ["PAPER", "BEST_PUBLISHED", "ISO_ALLOWANCE_MM", "measurement_table",
-           "important_table", "iso_verdicts", "failure_lines", "mean_of_important"]
+           "important_table", "iso_verdicts", "failure_lines", "mean_of_important",
+           "paired_difference"]
 
 #: The paper's Table 3 (mean, sd of |error|, mm), and its mean of the 7 important.
 PAPER = {"A": (3.1, 3.5), "B": (2.1, 2.0), "C": (2.2, 3.5), "D": (2.5, 3.2), "E": (5.1, 7.1),
@@ -78,20 +79,48 @@ def mean_of_important(errors: np.ndarray) -> tuple[float, float, float]:
     return float(absolute.mean()), float(absolute.std(ddof=1)), float(per_subject.mae_ci[0])
 
 
-def important_table(runs: dict[str, RunScores]) -> list[str]:
+def paired_difference(run: RunScores, baseline: RunScores) -> tuple[float, float, int]:
+    """``run``'s 7-measurement mean |error| minus ``baseline``'s, subject by subject over
+    the subjects both fitted: (mean difference, half-width of its 95 % interval (Student
+    t), subjects), mm. Pairing removes the subjects' own difficulty from the comparison."""
+    common = sorted(set(run.ids) & set(baseline.ids))
+
+    def per_subject(scores: RunScores) -> np.ndarray:
+        row = {subject: i for i, subject in enumerate(scores.ids)}
+        chosen = np.abs(scores.errors[[row[s] for s in common]])[:, IMPORTANT_COLUMNS]
+        return chosen.mean(axis=1)
+
+    s = error_stats((per_subject(run) - per_subject(baseline))[:, None])
+    return float(s.bias[0]), float(s.bias_ci[0]), len(common)
+
+
+def important_table(runs: dict[str, RunScores],
+                    baselines: dict[str, str] | None = None) -> list[str]:
     """Table 4 form: one row per run, the 7 important measurements' mean |error| and
-    their mean (+- its 95 % interval), subjects and failures."""
+    their mean (+- its 95 % interval), subjects and failures; with ``baselines`` (row
+    name -> the name of the row it is compared with), a last column with the
+    :func:`paired_difference` from that row."""
+    paired = baselines is not None
     lines = [f"| setting | subjects fitted | failed | {' | '.join(IMPORTANT)} | mean of 7 "
-             "(95 % CI) |", "|---|---|---|" + "---|" * len(IMPORTANT) + "---|"]
+             "(95 % CI) |" + (" paired difference (95 % CI) |" if paired else ""),
+             "|---|---|---|" + "---|" * (len(IMPORTANT) + 1 + paired)]
     for name, scores in runs.items():
         mae = np.abs(scores.errors).mean(axis=0)
         mean, _, ci = mean_of_important(scores.errors)
-        lines.append(f"| {name} | {len(scores.ids)} | {len(scores.failures)} | "
-                     + " | ".join(f"{mae[KEYS.index(k)]:.1f}" for k in IMPORTANT)
-                     + f" | **{mean:.2f}** (±{ci:.2f}) |")
+        line = (f"| {name} | {len(scores.ids)} | {len(scores.failures)} | "
+                + " | ".join(f"{mae[KEYS.index(k)]:.1f}" for k in IMPORTANT)
+                + f" | **{mean:.2f}** (±{ci:.2f}) |")
+        if paired:
+            baseline = baselines.get(name)
+            if baseline is None:
+                line += " |"
+            else:
+                diff, diff_ci, _ = paired_difference(scores, runs[baseline])
+                line += f" {diff:+.2f} (±{diff_ci:.2f}) from {baseline} |"
+        lines.append(line)
     lines.append(f"| paper (its own model) | 500 | | "
                  + " | ".join(f"{PAPER[k][0]:.1f}" for k in IMPORTANT)
-                 + f" | {PAPER['mean'][0]:.1f} |")
+                 + f" | {PAPER['mean'][0]:.1f} |" + (" |" if paired else ""))
     return lines
 
 

@@ -149,3 +149,32 @@ def test_failures_are_counted_by_reason():
                         ("s3", "the person is cut off by the frame")], np.zeros(0, bool))
     assert failure_lines(scores) == ["- 2 x no person found in /x/<id>/front.jpg",
                                      "- 1 x the person is cut off by the frame"]
+
+
+def test_paired_difference_is_scipys_paired_t_interval_over_common_subjects():
+    from bodyfit.fitter.accuracy.report import important_table, paired_difference
+    from bodyfit.fitter.accuracy.scores import IMPORTANT_COLUMNS, RunScores
+
+    rng = np.random.default_rng(1)
+    base_errors, run_errors = rng.normal(0, 5, (30, 16)), rng.normal(1, 5, (30, 16))
+    ids = [f"s{i:04d}" for i in range(30)]
+
+    def scores(subjects, errors):
+        n = len(subjects)
+        return RunScores(subjects, errors, np.zeros((n, 16)), np.zeros(n), [], np.zeros(n, bool))
+
+    # the run fitted subjects 5..29 only, in another order: pairing must follow the ids
+    order = rng.permutation(np.arange(5, 30))
+    base = scores(ids, base_errors)
+    run = scores([ids[i] for i in order], run_errors[order])
+    diff, ci, count = paired_difference(run, base)
+    a = np.abs(run_errors[5:, IMPORTANT_COLUMNS]).mean(axis=1)
+    b = np.abs(base_errors[5:, IMPORTANT_COLUMNS]).mean(axis=1)
+    interval = stats.ttest_rel(a, b).confidence_interval(0.95)
+    assert count == 25
+    assert diff == pytest.approx((interval.low + interval.high) / 2)
+    assert ci == pytest.approx((interval.high - interval.low) / 2)
+    table = important_table({"base": base, "run": run}, {"run": "base"})
+    assert table[0].endswith("paired difference (95 % CI) |")
+    assert table[3].endswith(f"{diff:+.2f} (±{ci:.2f}) from base |")
+    assert table[2].endswith("| |")  # the baseline's own row has no difference
