@@ -98,9 +98,9 @@ def important_table(runs: dict[str, RunScores],
                     baselines: dict[str, str] | None = None) -> list[str]:
     """Table 4 form: one row per run, the 7 important measurements' mean |error| and
     their mean (+- its 95 % interval), subjects and failures; with ``baselines`` (row
-    name -> the name of the row it is compared with), a last column with the
-    :func:`paired_difference` from that row."""
-    paired = baselines is not None
+    name -> the name of the row it is compared with; none: no such column), a last
+    column with the :func:`paired_difference` from that row."""
+    paired = bool(baselines)
     lines = [f"| setting | subjects fitted | failed | {' | '.join(IMPORTANT)} | mean of 7 "
              "(95 % CI) |" + (" paired difference (95 % CI) |" if paired else ""),
              "|---|---|---|" + "---|" * (len(IMPORTANT) + 1 + paired)]
