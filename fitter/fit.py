@@ -25,7 +25,7 @@ from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
 from bodyfit.fitter.search import SearchResult, SearchSettings, search
 from bodyfit.fitter.side_arms import side_view_options
-from bodyfit.fitter.stature import StatureConditioner, stature_scale
+from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
 from bodyfit.fitter.weights import cost_settings
 
 __all__ = ["FitSettings", "METHODS", "Fit", "fit_person"]
@@ -138,7 +138,7 @@ def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult,
     k = len(result.betas)
     rest, _ = rest_shape(model, result.final_genes[chosen, :k])
     if stature_m is not None:
-        rest = np.stack([body * stature_scale(body, stature_m) for body in rest])
+        rest = scaled_to_stature(rest, stature_m)
     values = measurer.measure_many(rest)
     spread = np.nanstd(values, axis=0, ddof=1) if len(chosen) > 1 else np.full(16, np.nan)
     return dict(zip(MEASUREMENTS, spread.tolist()))

@@ -27,7 +27,7 @@ import numpy as np
 
 from bodyfit.fitter.body_model import BodyModel, forward
 
-__all__ = ["StatureConditioner", "stature_scale"]
+__all__ = ["StatureConditioner", "stature_scale", "scaled_to_stature"]
 
 #: Vertices within this distance (metres) of the top or bottom of any extreme body are
 #: the candidates for a body's highest and lowest points (679 of 13,348 vertices; over
@@ -102,3 +102,8 @@ class StatureConditioner:
 def stature_scale(rest_vertices: np.ndarray, stature_m: float) -> float:
     """The uniform scale that gives a (V, 3) rest body the stature ``stature_m``."""
     return float(stature_m / np.ptp(rest_vertices[:, 2]))
+
+
+def scaled_to_stature(rest_bodies: np.ndarray, stature_m: float) -> np.ndarray:
+    """(N, V, 3) rest bodies, each scaled by its own :func:`stature_scale` to ``stature_m``."""
+    return np.stack([body * stature_scale(body, stature_m) for body in rest_bodies])

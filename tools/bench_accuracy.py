@@ -88,6 +88,12 @@ def _command(name: str) -> str:
     return str(beside) if beside.exists() else name
 
 
+def _table_rows(folder: Path, first: int, keepends: bool = False) -> list[str]:
+    """subjects.csv's header and its first ``first`` rows: as many women as men
+    (subject_set's order)."""
+    return (folder / "subjects.csv").read_text().splitlines(keepends)[:first + 1]
+
+
 def fit(args, batch_options: list[str]) -> None:
     folder = Path(args.set)
     if not (folder / "subjects.csv").exists():
@@ -100,12 +106,9 @@ def fit(args, batch_options: list[str]) -> None:
                        stdout=subprocess.DEVNULL)
     out = folder / "runs" / args.name
     table = folder / "subjects.csv"
-    lines = table.read_text().splitlines(keepends=True)
-    if args.first:  # the table's first rows: as many women as men (subject_set's order)
-        lines = lines[:args.first + 1]
+    if args.first:
         table = folder / f"subjects-first{args.first}.csv"
-    if table != folder / "subjects.csv":
-        table.write_text("".join(lines))
+        table.write_text("".join(_table_rows(folder, args.first, keepends=True)))
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
                *(["--camera", str(camera)] if args.camera == "calibrated" else []),
                *batch_options]
@@ -171,7 +174,7 @@ def report(args) -> None:
             baselines[label] = baseline
         scores = read_scores(set_folder, run)
         if args.first:  # the set's first N subjects (those of `fit --first N`)
-            rows = (set_folder / "subjects.csv").read_text().splitlines()[1:args.first + 1]
+            rows = _table_rows(set_folder, args.first)[1:]
             scores = _subset(scores, {row.split(",")[0] for row in rows})
         table4[label] = scores
         print(f"- {label}: {_timing(scores, run)}")

@@ -18,7 +18,7 @@ from bodyfit.fitter.accuracy.bodies import Bodies
 from bodyfit.fitter.accuracy.subject_set import subject_ids
 from bodyfit.fitter.body_model import BodyModel, rest_shape
 from bodyfit.fitter.measurements import Measurer
-from bodyfit.fitter.stature import stature_scale
+from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.render import render_colours
 
 __all__ = ["error_per_generation", "distance_panel", "colour_bar", "fitted_rest_body"]
@@ -35,7 +35,7 @@ def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
     rest = rest_shape(model, picked)[0]
     if record["settings"]["search"]["condition_stature"]:
         stature_m = record["inputs"]["height_cm"] / 100.0
-        rest = np.stack([body * stature_scale(body, stature_m) for body in rest])
+        rest = scaled_to_stature(rest, stature_m)
     return rest
 
 

@@ -6,7 +6,7 @@ import pytest
 from bodyfit.fitter.body_model import forward, rest_shape
 from bodyfit.fitter.search import SearchSettings
 from bodyfit.fitter.canvas import extreme_bodies
-from bodyfit.fitter.stature import StatureConditioner, stature_scale
+from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
 
 
 def range_bodies(model):
@@ -41,6 +41,13 @@ def test_stature_scale_restores_the_stature(body_model):
     rest, _ = rest_shape(body_model, np.full((1, 20), 0.3))
     scale = stature_scale(rest[0], 1.8)
     assert np.ptp(rest[0][:, 2] * scale) == pytest.approx(1.8)
+
+
+def test_scaled_to_stature_scales_each_body_by_its_own_factor(body_model):
+    rest, _ = rest_shape(body_model, np.array([[0.3] * 20, [-1.5] * 20]))
+    scaled = scaled_to_stature(rest, 1.8)
+    assert np.ptp(scaled[:, :, 2], axis=1) == pytest.approx([1.8, 1.8])
+    assert scaled[1] == pytest.approx(rest[1] * stature_scale(rest[1], 1.8))
 
 
 def test_conditioned_search_leaves_the_first_beta_out_of_the_genes():
