@@ -42,7 +42,8 @@ class FitSettings:
         search: optimiser and space.
         canvas: canvas geometry.
         cost: the kernels' weights, matching and alignment (default: the ``bodyfit``
-            weights preset, symmetric matching, the vertical anchor on the extremes).
+            weights preset, model -> person matching, the vertical anchor on the
+            extremes; docs/accuracy.md measured the matching directions).
         device: where the kernels run, "cpu" or "cuda:0".
         threads: CPU threads evaluating each population side by side (None: one per core
             this process may use; ignored on a GPU). The result does not depend on it.
@@ -63,7 +64,8 @@ class FitSettings:
     search: SearchSettings = SearchSettings()
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
-        "bodyfit", base=kernels.CostSettings(matching="symmetric", vertical_anchor="extremes"))
+        "bodyfit", base=kernels.CostSettings(matching="model_to_person",
+                                       vertical_anchor="extremes"))
     device: str = "cpu"
     threads: int | None = None
     render_cell_mm: float = 8.0
