@@ -28,8 +28,9 @@ subtraction and shadow detection", 1999):
    raises the IoU from 0.96 to 0.997). The step runs ``outline_passes`` times, each
    from the outline the last one left: JPEG's ringing lets the low threshold put the
    first outline 2-3 px outside the edge, so one pass still takes the local person
-   colour partly from mixed pixels and leaves the outline about 0.4 px per edge too far
-   out; four passes leave 0.08 px (docs/accuracy.md, "Pushing the numbers").
+   colour partly from mixed pixels; on the accuracy benchmark's JPEG photos it left the
+   outline 0.24 px outside the exact one on average, four passes leave 0.05 px
+   (docs/accuracy.md, "Pushing the numbers").
 5. Enclosed holes smaller than ``max_hole_fraction`` of the person are filled (larger
    ones are real gaps, e.g. between an arm and the body with a hand on the hip).
 

@@ -78,22 +78,41 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
         distance_m: from the camera to the body's vertical axis (model origin).
         camera_height_m: the camera above the floor (the body's lowest vertex).
 
-    The person's pixels are those the body covers by more than half (sub-pixel outline).
+    The person's pixels are those the body covers by more than half
+    (:func:`pinhole_silhouette`).
     """
     faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
-    floor = float(vertices[:, 2].min())
-    rotation, translation = Placement(distance_m, camera_height_m, 0.0, -floor).extrinsics(view)
+    rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m)
     image = render_pinhole(vertices, faces, face_parts, intrinsics, rotation, translation,
                            size_px)
-    body = coverage_mask(pinhole_pixels(vertices, intrinsics, rotation, translation)[0], faces,
-                         size_px)
+    body = pinhole_silhouette(vertices, model, view, parts, intrinsics, size_px, distance_m,
+                              camera_height_m)
     canvas = np.full_like(image, BACKDROP_BGR)
     canvas[body] = image[body]
     return canvas
 
 
-__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "lens_photo", "write_subject", "write_pinhole_photos",
-           "write_pinhole_subject"]
+def pinhole_silhouette(vertices, model, view: str, parts, intrinsics: np.ndarray,
+                       size_px: tuple[int, int], distance_m: float,
+                       camera_height_m: float) -> np.ndarray:
+    """(H, W) bool: the pixels of :func:`pinhole_photo` (same arguments) that the body
+    covers by more than half (:func:`bodyfit.fitter.render.coverage_mask`): the exact
+    silhouette an extraction from the photo should find."""
+    faces, _ = visible_faces(model.faces, model.face_parts, parts)
+    rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m)
+    return coverage_mask(pinhole_pixels(vertices, intrinsics, rotation, translation)[0], faces,
+                         size_px)
+
+
+def _extrinsics(vertices: np.ndarray, view: str, distance_m: float,
+                camera_height_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """(rotation (3, 3), translation (3,) metres) of :func:`pinhole_photo`'s camera."""
+    floor = float(vertices[:, 2].min())
+    return Placement(distance_m, camera_height_m, 0.0, -floor).extrinsics(view)
+
+
+__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "pinhole_silhouette", "lens_photo",
+           "write_subject", "write_pinhole_photos", "write_pinhole_subject"]
 
 
 

@@ -11,6 +11,8 @@
     # Markdown tables (docs/accuracy.md holds them)
     python tools/bench_accuracy.py report --main "in-space=SETS/in:default" \
         --ablation "uniform weights=SETS/in:uniform-weights"
+    # how far calib's extracted outlines lie from the exact silhouettes, per refinement passes
+    python tools/bench_accuracy.py outlines SETS/in --first 10 --passes 1 2 4
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python tools/bench_accuracy.py figures SETS/in --curve "bodyfit=default" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -40,18 +42,21 @@ import cv2
 import numpy as np
 
 from bodyfit.calib.images import write_image
-from bodyfit.fitter.accuracy.bodies import KINDS
+from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
+from bodyfit.fitter.accuracy.bodies import KINDS, pose_bodies
 from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, error_per_generation,
                                              fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table,
                                             measurement_table)
 from bodyfit.fitter.accuracy.scores import read_scores
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
-                                                 subject_ids, write_bodies,
+                                                 read_settings, subject_ids, write_bodies,
                                                  write_photos_of_set)
+from bodyfit.fitter.body_model import PART_NAMES
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
+from bodyfit.fitter.studio_photos import pinhole_silhouette
 
 
 def _photograph(folder: str, subjects: list[int]) -> None:
@@ -126,6 +131,43 @@ def fit(args, batch_options: list[str]) -> None:
     runs = json.loads(previous.read_text())["runs"] if previous.exists() else []
     previous.write_text(json.dumps({"runs": [*runs, record]}, indent=1))
     print(f"{out}: fitter batch exit {code} in {wall:.0f} s")
+
+
+def outlines(args) -> None:
+    """calib's silhouettes of a set's photos against the exact ones, per outline passes.
+
+    The exact silhouette of a photo is the pixels its body covers by more than half
+    (:func:`pinhole_silhouette`, in the undistorted frame); the extracted one is
+    ``photo_silhouette``'s, undistorted through the set's true camera, so that only the
+    extraction is measured. Prints, per number of passes, the mean over photos of the
+    outline's outward offset (extra minus missed pixels per outline pixel of the exact
+    silhouette, pixels) and of the pixels wrong per outline pixel.
+    """
+    folder = Path(args.set)
+    model = load_model()
+    bodies, camera = read_bodies(model, folder), read_settings(folder).camera
+    ids = subject_ids(len(bodies.sex), bodies.sex)
+    offsets: dict[int, list[tuple[float, float]]] = {passes: [] for passes in args.passes}
+    for index in range(args.first):
+        truth = json.loads((folder / ids[index] / "truth.json").read_text())
+        for view, posed in zip(("front", "side"), pose_bodies(model, bodies, index)):
+            exact = pinhole_silhouette(posed, model, view, PART_NAMES, camera.K,
+                                       camera.image_size_px, truth["camera_distance_m"],
+                                       truth["camera_height_m"])
+            contours, _ = cv2.findContours(exact.astype(np.uint8), cv2.RETR_EXTERNAL,
+                                           cv2.CHAIN_APPROX_NONE)
+            outline = sum(len(contour) for contour in contours)
+            for passes in args.passes:
+                mask = photo_silhouette(folder / ids[index] / f"{view}.jpg", camera,
+                                        settings=SilhouetteSettings(outline_passes=passes))
+                extra, missed = int(np.sum(mask & ~exact)), int(np.sum(~mask & exact))
+                offsets[passes].append(((extra - missed) / outline, (extra + missed) / outline))
+    print(f"{folder}, the first {args.first} subjects ({2 * args.first} photos), against "
+          "the exact silhouettes:\n\n| outline passes | outward offset (px) | pixels wrong "
+          "per outline pixel |\n|---|---|---|")
+    for passes, values in offsets.items():
+        outward, wrong = np.mean(values, axis=0)
+        print(f"| {passes} | {outward:+.3f} | {wrong:.3f} |")
 
 
 def _run_spec(spec: str) -> tuple[str, Path, Path]:
@@ -261,6 +303,11 @@ def main() -> None:
                    help="a run in the Table 4 form only")
     p.add_argument("--first", type=int, help="the ablations' rows over their set's first N "
                    "subjects only (compare runs of `fit --first N` with a full run)")
+    p = sub.add_parser("outlines", help="extracted silhouettes against the exact ones")
+    p.add_argument("set")
+    p.add_argument("--first", type=int, default=10, help="the set's first N subjects")
+    p.add_argument("--passes", type=int, nargs="+", default=[1, 2, 4],
+                   help="outline refinement passes to compare (SilhouetteSettings.outline_passes)")
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
@@ -276,7 +323,8 @@ def main() -> None:
     if args.command == "fit":
         fit(args, batch_options)
     else:
-        {"make": make, "report": report, "figures": figures}[args.command](args)
+        {"make": make, "report": report, "outlines": outlines,
+         "figures": figures}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -137,6 +137,11 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert last == pytest.approx(mean7, abs=0.06)
     for name in ("accuracy_error_per_generation.png", "accuracy_meshes.png"):
         assert cv2.imread(str(tmp_path / name)) is not None
+    # calib's silhouettes of the JPEGs against the geometry's exact coverage: with the
+    # default passes on the edge within a tenth of a pixel, one pass clearly outside
+    printed = tool("outlines", str(subject_set), "--first", "2", "--passes", "1", "4")
+    outward = {int(m[1]): float(m[2]) for m in re.finditer(r"\| (\d) \| ([-+.\d]+) \|", printed)}
+    assert abs(outward[4]) < 0.1 and outward[1] > 0.15
 
 
 def test_failures_are_counted_by_reason():
