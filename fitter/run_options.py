@@ -47,7 +47,6 @@ def base_settings(method: str | None, config: Path | None
 def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSettings:
     """``base`` with every fit option of ``options`` that is not None applied: the search's
     (``SEARCH_OPTIONS``, ``free_stature``), the cost's (``matching``, ``vertical_anchor``,
-    ``cost_mean`` ("count" or "weighted"),
     ``weights`` (a preset or a .toml file, replacing the weights) and ``weight`` (a list of
     ``NAME=VALUE`` overrides on top)), ``device``, ``threads``, ``side_arms``,
     ``projection`` and ``placement_rounds``.
@@ -63,8 +62,6 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
         search = dataclasses.replace(search, condition_stature=False)
     cost = dataclasses.replace(base.cost, **{k: given[k] for k in ("matching", "vertical_anchor")
                                              if k in given})
-    if "cost_mean" in given:
-        cost = dataclasses.replace(cost, weighted_mean=given["cost_mean"] == "weighted")
     if "weights" in given:
         cost = cost_settings(given["weights"], given.get("weight", []), cost)
     elif "weight" in given:  # on top of the method's or the recorded weights

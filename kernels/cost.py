@@ -11,13 +11,6 @@ each weighted by its own part, the distance to the person's boundary (the person
 distance transform, bilinearly interpolated): (1/m) sum_j w_part(x_j) d(x_j, Z).
 ``"symmetric"`` averages the two sums. Then f = w_front f_front + w_side f_side (Eq. 17).
 
-With ``weighted_mean`` each direction's sum is divided by its weights' sum instead of
-its count, sum_i w_part(x_i) |z_i - x_i| / sum_i w_part(x_i): a weighted mean distance.
-The paper's count mean rewards a candidate for letting light parts take over its
-outline (at equal distances it costs the mean weight of its boundary's parts times the
-distance, so shrinking the chest (5) where an arm (3) lies next to it pays); the
-weighted mean costs the same distance whichever parts hold the outline.
-
 The highest and lowest points are those of the silhouettes' top and bottom rows, and
 dis() is their vertical distance after the alignment: the soles are flat, so which heel
 or toe reaches the lowest row (and so a point's column) jumps between similar bodies,
@@ -78,8 +71,6 @@ class CostSettings:
         vertical_anchor: how the vertical shift is found: ``"centroid"`` (the paper's
             normalisation by the silhouettes' moments) or ``"extremes"`` (the middle of the
             top and bottom rows; :func:`bodyfit.kernels.alignment.launch_alignment`).
-        weighted_mean: divide each direction's weighted distance sum by the sum of its
-            points' weights, not by their count (the paper's); module docstring.
     """
 
     part_weights: tuple[float, ...] = (2.0, 5.0, 5.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0)
@@ -90,7 +81,6 @@ class CostSettings:
     matching: str = "person_to_model"
     align_rotation: bool = True
     vertical_anchor: str = "centroid"
-    weighted_mean: bool = False
 
     def __post_init__(self):
         if len(self.part_weights) != NUM_PARTS:
@@ -119,7 +109,6 @@ class CostParams:
         scale: view weight x millimetres per pixel.
         person_to_model, model_to_person: weights of the two directions' means (1 and 0,
             0 and 1, or 0.5 and 0.5).
-        weighted_mean: 1: each mean divides by its points' weights, 0: by their count.
     """
 
     part_weights: PartVector
@@ -128,7 +117,6 @@ class CostParams:
     scale: float
     person_to_model: float
     model_to_person: float
-    weighted_mean: int
 
 
 def cost_params(settings: CostSettings, view_name: str,
@@ -140,7 +128,6 @@ def cost_params(settings: CostSettings, view_name: str,
     params.bottom_weight = settings.bottom_weight
     params.scale = settings.view_weight(view_name) * millimetres_per_pixel
     params.person_to_model, params.model_to_person = MATCHING_WEIGHTS[settings.matching]
-    params.weighted_mean = int(settings.weighted_mean)
     return params
 
 
@@ -170,40 +157,27 @@ def _model_to_person_kernel(runs: wp.array3d(dtype=wp.int32),
                             transforms: wp.array(dtype=wp.mat33),
                             person_distance: wp.array2d(dtype=wp.float32),
                             row_sums: wp.array2d(dtype=PartVector),
-                            row_pixels: wp.array2d(dtype=PartVector)):
+                            row_pixels: wp.array2d(dtype=wp.int32)):
     p, y = wp.tid()
     to_person = wp.inverse(transforms[p])
     sums = PartVector()
-    pixels = PartVector()
+    pixels = int(0)
     for i in range(run_counts[p, y]):
         packed = runs[p, y, i]
         part = run_part(packed)
         for x in range(run_start(packed), run_end(packed) + 1):
             q = transform_point(to_person, wp.vec2(float(x), float(y)))
             sums[part] = sums[part] + _interpolate_distance(person_distance, q)
-            pixels[part] = pixels[part] + 1.0
+            pixels = pixels + 1
     row_sums[p, y] = sums
     row_pixels[p, y] = pixels
-
-
-@wp.func
-def _mean_divisor(params: CostParams, counts: PartVector):
-    """The divisor of one direction's part sums: its points' count, or (weighted mean)
-    the sum of their parts' weights."""
-    total = float(0.0)
-    for k in range(NUM_PARTS):
-        if params.weighted_mean != 0:
-            total = total + params.part_weights[k] * counts[k]
-        else:
-            total = total + counts[k]
-    return wp.max(total, 1.0e-6)  # a boundary of weightless parts only: every term 0
 
 
 @wp.kernel(enable_backward=False)
 def _view_cost_kernel(params: CostParams, target: WarpSilhouetteMoments,
                       distances: wp.array2d(dtype=wp.float32), parts: wp.array2d(dtype=wp.int32),
                       row_sums: wp.array2d(dtype=PartVector),
-                      row_pixels: wp.array2d(dtype=PartVector),
+                      row_pixels: wp.array2d(dtype=wp.int32),
                       transforms: wp.array(dtype=wp.mat33), extremes: wp.array2d(dtype=wp.vec2),
                       areas: wp.array(dtype=wp.float32), term_costs: wp.array2d(dtype=wp.float32),
                       costs: wp.array(dtype=wp.float32)):
@@ -216,18 +190,17 @@ def _view_cost_kernel(params: CostParams, target: WarpSilhouetteMoments,
     terms = PartVector()
     if params.person_to_model > 0.0:
         sums = PartVector()
-        counts = PartVector()
-        for i in range(distances.shape[1]):
+        num = distances.shape[1]
+        for i in range(num):
             sums[parts[p, i]] = sums[parts[p, i]] + distances[p, i]
-            counts[parts[p, i]] = counts[parts[p, i]] + 1.0
-        terms = terms + (params.person_to_model / _mean_divisor(params, counts)) * sums
+        terms = terms + (params.person_to_model / float(num)) * sums
     if params.model_to_person > 0.0:
         sums = PartVector()
-        counts = PartVector()
+        pixels = int(0)
         for y in range(row_sums.shape[1]):
             sums = sums + row_sums[p, y]
-            counts = counts + row_pixels[p, y]
-        terms = terms + (params.model_to_person / _mean_divisor(params, counts)) * sums
+            pixels = pixels + row_pixels[p, y]
+        terms = terms + (params.model_to_person / float(pixels)) * sums
     to_person = wp.inverse(transforms[p])
     top = wp.abs(transform_point(to_person, extremes[p, 0])[1] - target.top[1])
     bottom = wp.abs(transform_point(to_person, extremes[p, 1])[1] - target.bottom[1])
@@ -247,8 +220,7 @@ def launch_model_to_person(runs: wp.array, run_counts: wp.array, transforms: wp.
                            person_distance: wp.array, row_sums: wp.array,
                            row_pixels: wp.array) -> None:
     """Per row of every candidate: the part sums of its boundary pixels' distances to the
-    person's boundary (row_sums (P, H) PartVector) and their counts per part (row_pixels
-    (P, H) PartVector)."""
+    person's boundary (row_sums (P, H) PartVector) and their count (row_pixels (P, H))."""
     wp.launch(_model_to_person_kernel, dim=run_counts.shape, device=runs.device,
               inputs=[runs, run_counts, transforms, person_distance],
               outputs=[row_sums, row_pixels])

@@ -90,7 +90,7 @@ class _ViewBuffers:
         self.distances = wp.empty((chunk, num_points), dtype=wp.float32, device=dev)
         self.parts = wp.empty((chunk, num_points), dtype=wp.int32, device=dev)
         self.row_sums = wp.empty((chunk, view.height), dtype=PartVector, device=dev)
-        self.row_pixels = wp.empty((chunk, view.height), dtype=PartVector, device=dev)
+        self.row_pixels = wp.empty((chunk, view.height), dtype=wp.int32, device=dev)
 
     def arrays(self) -> list[wp.array]:
         return [v for v in (*vars(self).values(), *vars(self.scan).values())

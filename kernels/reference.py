@@ -119,21 +119,18 @@ def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) 
     weights = np.asarray(settings.part_weights)
     num_parts = len(PART_NAMES)
     person = view.boundary_points.numpy().astype(np.float64)
-    def part_means(point_parts: np.ndarray, distances: np.ndarray) -> np.ndarray:
-        sums = np.bincount(point_parts, distances, num_parts)
-        divisor = weights[point_parts].sum() if settings.weighted_mean else len(point_parts)
-        return sums / max(divisor, 1e-6)
-
     forward_sums = np.zeros(num_parts)
     if settings.matching != "model_to_person":
         moved = person @ to_candidate[:2, :2].T + to_candidate[:2, 2]
         distances, nearest = cKDTree(model_points).query(moved)
-        forward_sums = part_means(model_parts[nearest], distances)
+        np.add.at(forward_sums, model_parts[nearest], distances)
+        forward_sums /= len(person)
     backward_sums = np.zeros(num_parts)
     if settings.matching != "person_to_model":
         moved = model_points @ to_person[:2, :2].T + to_person[:2, 2]
         distances = interpolate_distance(view.boundary_distance.numpy(), moved)
-        backward_sums = part_means(model_parts, distances)
+        np.add.at(backward_sums, model_parts, distances)
+        backward_sums /= len(model_points)
     mix = MATCHING_WEIGHTS[settings.matching]
     parts = weights * (mix[0] * forward_sums + mix[1] * backward_sums)
     top = abs((to_person[:2, :2] @ moments.top + to_person[:2, 2] - view.moments.top)[1])

@@ -43,12 +43,11 @@ def candidates(truth):
     return np.concatenate([truth[0], betas]), np.concatenate([truth[1], pose])
 
 
-@pytest.mark.parametrize("matching,anchor,weighted", [(m, "centroid", False) for m in MATCHING_DIRECTIONS]
-                         + [("person_to_model", "extremes", False), ("symmetric", "extremes", False)]
-                         + [(m, "extremes", True) for m in MATCHING_DIRECTIONS])
+@pytest.mark.parametrize("matching,anchor", [(m, "centroid") for m in MATCHING_DIRECTIONS]
+                         + [("person_to_model", "extremes"), ("symmetric", "extremes")])
 def test_cost_terms_equal_the_numpy_formula(body_model, model_arrays, views, candidates,
-                                            matching, anchor, weighted):
-    settings = CostSettings(matching=matching, vertical_anchor=anchor, weighted_mean=weighted)
+                                            matching, anchor):
+    settings = CostSettings(matching=matching, vertical_anchor=anchor)
     costs, part_costs = evaluate_population(model_arrays, views, *candidates, settings)
     expected = np.zeros_like(part_costs, dtype=np.float64)
     for view, camera, width in zip(views, (front_camera(), side_camera()),
@@ -60,23 +59,7 @@ def test_cost_terms_equal_the_numpy_formula(body_model, model_arrays, views, can
     assert np.allclose(costs, expected.sum(axis=1), rtol=1e-4, atol=1e-2)
     # parts can differ only where a person point is equally far from two candidate parts
     assert np.allclose(part_costs, expected, rtol=1e-3, atol=0.02 * costs.max())
-    assert costs[0] < 1e-3 and (costs[1:] > 20).all()
-
-
-@pytest.mark.parametrize("matching", MATCHING_DIRECTIONS)
-def test_weighted_mean_is_a_mean_of_the_distances(model_arrays, views, candidates, matching):
-    """Equal weights c: the weighted mean is the plain mean distance whatever c (the
-    count mean: c times it); scaling unequal weights leaves the weighted mean alone."""
-    def costs(weights, weighted):
-        settings = CostSettings(part_weights=weights, top_weight=0.0, bottom_weight=0.0,
-                                matching=matching, weighted_mean=weighted)
-        return evaluate_population(model_arrays, views, *candidates, settings)[0]
-
-    plain = costs((1.0,) * 9, False)
-    assert np.allclose(costs((4.0,) * 9, True), plain, rtol=1e-5)
-    assert np.allclose(costs((4.0,) * 9, False), 4 * plain, rtol=1e-5)
-    table2 = CostSettings().part_weights
-    assert np.allclose(costs(tuple(3 * w for w in table2), True), costs(table2, True), rtol=1e-5)
+    assert costs[0] < 1e-3 and (costs[1:] > 100).all()
 
 
 def test_cost_grows_away_from_the_true_body(model_arrays, views, truth):
