@@ -35,8 +35,8 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                                  "run.json (the options given here override them)")
     parser.add_argument("--method", choices=("bodyfit", "paper"),
                         help="bodyfit (default: CMA-ES 30 x 150, stature-conditioned "
-                             "candidates, model-to-person matching, bodyfit weights, the camera placed "
-                             "anew from the best body) or paper (the "
+                             "candidates, model-to-person matching, bodyfit weights, the "
+                             "camera placed anew from the best body) or paper (the "
                              "paper's method exactly: its GA 30 x 25, Table 2 weights, "
                              "person-to-model matching); the options below override single "
                              "settings")
@@ -83,10 +83,6 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     parser.add_argument("--matching",
                         help="boundary matching direction: model_to_person (default), "
                              "person_to_model (the paper's) or symmetric (both)")
-    parser.add_argument("--cost-mean", choices=("count", "weighted"),
-                        help="each matching direction's mean: weighted (default; the sum of "
-                             "weighted distances over the sum of the weights) or count (the "
-                             "paper's: over the number of points)")
     parser.add_argument("--vertical-anchor", choices=("centroid", "extremes"),
                         help="how candidates are shifted vertically onto the person: "
                              "centroid (the paper's moments) or extremes (the middle of the "

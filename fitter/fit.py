@@ -65,7 +65,7 @@ class FitSettings:
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="model_to_person",
-                                       vertical_anchor="extremes"))
+                                             vertical_anchor="extremes"))
     device: str = "cpu"
     threads: int | None = None
     render_cell_mm: float = 8.0
