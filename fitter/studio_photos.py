@@ -85,8 +85,7 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
     rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m)
     image = render_pinhole(vertices, faces, face_parts, intrinsics, rotation, translation,
                            size_px)
-    body = pinhole_silhouette(vertices, model, view, parts, intrinsics, size_px, distance_m,
-                              camera_height_m)
+    body = _covered(vertices, faces, intrinsics, rotation, translation, size_px)
     canvas = np.full_like(image, BACKDROP_BGR)
     canvas[body] = image[body]
     return canvas
@@ -100,6 +99,12 @@ def pinhole_silhouette(vertices, model, view: str, parts, intrinsics: np.ndarray
     silhouette an extraction from the photo should find."""
     faces, _ = visible_faces(model.faces, model.face_parts, parts)
     rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m)
+    return _covered(vertices, faces, intrinsics, rotation, translation, size_px)
+
+
+def _covered(vertices, faces, intrinsics, rotation, translation, size_px) -> np.ndarray:
+    """(H, W) bool: the pixels ``faces`` of ``vertices`` cover by more than half through
+    the pinhole (K ``intrinsics``, the extrinsics of :func:`_extrinsics`)."""
     return coverage_mask(pinhole_pixels(vertices, intrinsics, rotation, translation)[0], faces,
                          size_px)
 
