@@ -306,7 +306,13 @@ def extract_silhouette(
     brightness, chroma = _compare(image_bgr, backdrop)
 
     lit = band & (brightness >= settings.shadow_min_brightness) & (brightness <= settings.max_highlight_brightness)
-    lit_chroma = chroma[lit] if lit.any() else np.array([np.inf])
+    if not lit.any():
+        raise UserError(
+            "the frame border shows no lit backdrop (it is black, or far darker or brighter than "
+            f"the {'background plate' if background is not None else 'modelled backdrop'}); light "
+            "a plain backdrop evenly and let it fill the whole frame"
+        )
+    lit_chroma = chroma[lit]
     chroma_threshold = max(settings.min_chroma_distortion, settings.noise_factor * float(np.median(lit_chroma)))
     foreground = (
         (chroma > chroma_threshold)

@@ -1,5 +1,7 @@
 """Silhouettes of a synthetic person: accuracy, shadows, plates, holes and refusals."""
 
+import warnings
+
 import cv2
 import numpy as np
 import pytest
@@ -58,6 +60,13 @@ def test_a_jpeg_photo_keeps_its_outline_on_the_edge(studio):
     jpeg = cv2.imdecode(data, cv2.IMREAD_COLOR)
     assert abs(_outward_px(extract_silhouette(jpeg), truth)) < 0.05
     assert _outward_px(extract_silhouette(jpeg, settings=SilhouetteSettings(outline_passes=1)), truth) > 0.4
+
+
+def test_a_black_photo_is_refused_in_one_line_without_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no NumPy warning about an empty or infinite border
+        with pytest.raises(UserError, match="no lit backdrop"):
+            extract_silhouette(np.zeros((200, 150, 3), np.uint8))
 
 
 def test_the_shadow_is_really_there(studio):
