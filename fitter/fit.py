@@ -178,8 +178,16 @@ def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, set
     def place(done: int, betas: np.ndarray, pose_deg: np.ndarray) -> bool:
         if done not in at:
             return False
-        rest = rest_shape(model, betas[None])[0][0]
-        scale = stature_scale(rest, stature_m)
+        # the camera is placed for the body as the kernels render it: a conditioned
+        # candidate stands the stature tall *posed* (legs apart), where the person stands
+        # a few millimetres lower, so it is the person scaled by stature / (stature -
+        # delta), and so must its camera be. Scaled to the rest stature instead (the
+        # person's true size), the camera stood at the person's true distance and showed
+        # every candidate 0.2-0.7 % too tall; the search answered with bodies as much too
+        # thin (the chest 5-6 mm too small, docs/accuracy.md "Pushing the numbers").
+        scale = 1.0
+        if not settings.search.condition_stature:
+            scale = stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
         for name, view in views.items():
             body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0] * scale
             shown = np.isin(model.vertex_parts,
