@@ -28,7 +28,7 @@ from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
 from bodyfit.fitter.weights import cost_settings
 
-__all__ = ["FitSettings", "METHODS", "Fit", "fit_person"]
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "placement_body"]
 
 _SPREAD_SHARE = 0.25
 _SPREAD_MIN = 3
@@ -165,6 +165,29 @@ def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
                              settings.device, **view_options)
 
 
+def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
+                   view: kernels.ViewTarget, stature_m: float,
+                   condition_stature: bool) -> np.ndarray:
+    """(V', 3) float64 metres: the body a pinhole view's camera is placed from
+    (:func:`~bodyfit.fitter.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
+    (4,) degrees): the parts the view shows, in the view's pose, as the kernels render it.
+
+    A candidate conditioned on the stature stands the stature tall *posed* (legs apart),
+    where the person stands a few millimetres lower: it is the person scaled by
+    stature / (stature - delta), and its camera must stand as much farther, so it is
+    taken as it is. Scaled to the rest stature instead (the person's own size), the
+    camera stood at the person's true distance and showed every candidate 0.2-0.7 % too
+    tall, and the search answered with bodies as much too thin (the chest 6 mm too small;
+    docs/accuracy.md, "Pushing the numbers"). Without the conditioning a candidate has
+    its own height, and the camera is placed for it scaled to the person's stature.
+    """
+    body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
+    if not condition_stature:
+        body = body * stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
+    shown = np.isin(model.vertex_parts, [PART_NAMES.index(p) for p in view.visible_parts])
+    return body[shown].astype(np.float64)
+
+
 def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, settings):
     """The search's ``on_generation`` that places the pinhole cameras anew from the best
     body so far (:func:`~bodyfit.fitter.pinhole_canvas.placed_anew`) after each of
@@ -178,22 +201,10 @@ def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, set
     def place(done: int, betas: np.ndarray, pose_deg: np.ndarray) -> bool:
         if done not in at:
             return False
-        # the camera is placed for the body as the kernels render it: a conditioned
-        # candidate stands the stature tall *posed* (legs apart), where the person stands
-        # a few millimetres lower, so it is the person scaled by stature / (stature -
-        # delta), and so must its camera be. Scaled to the rest stature instead (the
-        # person's true size), the camera stood at the person's true distance and showed
-        # every candidate 0.2-0.7 % too tall; the search answered with bodies as much too
-        # thin (the chest 5-6 mm too small, docs/accuracy.md "Pushing the numbers").
-        scale = 1.0
-        if not settings.search.condition_stature:
-            scale = stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
         for name, view in views.items():
-            body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0] * scale
-            shown = np.isin(model.vertex_parts,
-                            [PART_NAMES.index(p) for p in view.visible_parts])
-            views[name] = placed_anew(view, masks[name], intrinsics[name],
-                                      body[shown].astype(np.float64))
+            body = placement_body(model, betas, pose_deg, view, stature_m,
+                                  settings.search.condition_stature)
+            views[name] = placed_anew(view, masks[name], intrinsics[name], body)
             evaluator.replace_view(views[name])
         return True
 

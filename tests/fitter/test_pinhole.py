@@ -13,9 +13,11 @@ from bodyfit.calib.images import to_upright
 from bodyfit.fitter.body_model import PART_NAMES, forward
 from bodyfit.fitter.canvas import VIEW_PARTS, CanvasSettings, extreme_bodies
 from bodyfit.fitter.cli import main
+from bodyfit.fitter.fit import placement_body
 from bodyfit.fitter.pinhole_canvas import (Placement, phone_intrinsics, pinhole_view,
                                            placed_anew, solve_placement, upright_intrinsics)
 from bodyfit.fitter.side_arms import side_photo_pose
+from bodyfit.fitter.stature import StatureConditioner
 from bodyfit.kernels import ModelArrays, PopulationEvaluator
 from bodyfit.fitter.run import RUN_FILES
 from bodyfit.calib.silhouette import photo_silhouette
@@ -218,3 +220,34 @@ def test_a_camera_of_another_size_is_refused(body_model, tmp_path, capsys):
                  str(tmp_path / "camera.json"), "-o", str(tmp_path / "out")])
     assert code == 2
     assert "turned 90 degrees" in capsys.readouterr().err
+
+
+def test_placement_rounds_place_the_camera_for_the_body_as_rendered(body_model, mean_body,
+                                                                     tmp_path):
+    """A candidate conditioned on the stature stands the stature tall with its legs apart,
+    the person about 2 cm lower (12 degrees apart): the camera placed from
+    ``placement_body`` shows it as tall as the person's silhouette; placed from it scaled to
+    the rest stature (the person's own size, as before), it showed it 1 % too tall."""
+    pose = np.array([5.0, 5.0, 12.0, 12.0])
+    truth = write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, pose, K_TRUE, SIZE_PX,
+                                  3.0, 1.2)
+    stature = truth["O"] / 1000
+    bodies = extreme_bodies(body_model, 20, [-5.0] * 4, [30.0] * 4)
+    candidate = StatureConditioner(body_model, 20, stature, 3.0, bodies).complete(
+        SUBJECT_BETAS[None, 1:], pose[None])[0]
+    rendered = forward(body_model, candidate[None], pose[None])[0].astype(np.float64)
+    for view in ("front", "side"):
+        mask = person_mask(cv2.imread(str(tmp_path / f"{view}.png")))
+        target = pinhole_view(view, mask, K_TRUE, stature, bodies.reshape(-1, 3), mean_body,
+                              body_model.vertex_parts)
+        rows = np.nonzero(target.silhouette)[0]
+        shown = np.isin(body_model.vertex_parts,
+                        [PART_NAMES.index(p) for p in target.visible_parts])
+        shown_px = {}
+        for conditioned in (True, False):
+            body = placement_body(body_model, candidate, pose, target, stature, conditioned)
+            k, r, t = camera_matrices(placed_anew(target, mask, K_TRUE, body).camera)
+            shown_px[conditioned] = np.ptp(project(k, r, t, rendered[shown])[:, 1])
+        person_px = rows.max() - rows.min() + 1
+        assert shown_px[True] == pytest.approx(person_px, abs=1.0), view
+        assert shown_px[False] - person_px > 0.008 * person_px, view
