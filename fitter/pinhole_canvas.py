@@ -259,8 +259,11 @@ def placed_anew(view: kernels.ViewTarget, mask: np.ndarray, intrinsics: np.ndarr
 
     Args:
         view: the view to place anew; mask, intrinsics: as for :func:`pinhole_view`.
-        body: (V, 3) metres, the parts the view shows of a body of the person's stature
-            in the view's pose.
+        body: (V, 3) metres, the parts the view shows of a body in the view's pose, at
+            the size the kernels render it (:func:`bodyfit.fitter.fit.placement_body`: a
+            candidate solved to the stature stands that tall posed, legs apart, so it is
+            the person scaled up by a few tenths of a per cent, and its camera must
+            stand as much farther).
     """
     placement = solve_placement(view.name, mask, np.asarray(intrinsics, float), body)
     k_canvas = camera_matrices(view.camera)[0]
