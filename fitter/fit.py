@@ -18,7 +18,7 @@ from threadpoolctl import threadpool_limits
 
 from bodyfit import kernels
 from bodyfit.calib.errors import UserError
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, BodyModel, forward, rest_shape
+from bodyfit.fitter.body_model import POSE_NAMES, BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
@@ -27,6 +27,7 @@ from bodyfit.fitter.search import SearchResult, SearchSettings, search
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
 from bodyfit.fitter.weights import cost_settings
+from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "placement_body"]
 
@@ -184,7 +185,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
     if not condition_stature:
         body = body * stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
-    shown = np.isin(model.vertex_parts, [PART_NAMES.index(p) for p in view.visible_parts])
+    shown = visible_vertices(model.vertex_parts, view.visible_parts)
     return body[shown].astype(np.float64)
 
 

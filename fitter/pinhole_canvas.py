@@ -47,8 +47,8 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.calib.errors import UserError
-from bodyfit.fitter.body_model import PART_NAMES
 from bodyfit.fitter.canvas import VIEW_PARTS, CanvasSettings
+from bodyfit.kernels.target import visible_vertices
 from bodyfit.kernels.view_camera import camera_matrices, paper_rotation
 
 __all__ = ["PHONE_HFOV_DEG", "Placement", "phone_intrinsics", "upright_intrinsics",
@@ -231,7 +231,7 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
     k = np.asarray(intrinsics, float)
     body = mean_body.astype(np.float64) * (stature_m / np.ptp(mean_body[:, 2]))
     visible = view_options.get("visible_parts", VIEW_PARTS[name])
-    shown = np.isin(vertex_parts, [PART_NAMES.index(p) for p in visible])
+    shown = visible_vertices(vertex_parts, visible)
     placement = solve_placement(name, mask, k, body[shown])
     r, t = placement.extrinsics(name)
     rows, cols = np.nonzero(mask)

@@ -24,7 +24,7 @@ from bodyfit.kernels.view_camera import ViewCamera
 from bodyfit.kernels.device import resolve_device
 
 __all__ = ["VIEW_NAMES", "SIDE_VIEW_PARTS", "ViewTarget", "prepare_view_target",
-           "visible_faces", "boundary_mask", "boundary_distance"]
+           "visible_faces", "visible_vertices", "boundary_mask", "boundary_distance"]
 
 #: The two views of the paper, in the order their weights appear in Table 2.
 VIEW_NAMES = ("front", "side")
@@ -40,6 +40,12 @@ def visible_faces(faces: np.ndarray, face_parts: np.ndarray,
     ``visible_parts`` (names from ``PART_NAMES``)."""
     keep = np.isin(face_parts, [PART_NAMES.index(name) for name in visible_parts])
     return faces[keep], face_parts[keep]
+
+
+def visible_vertices(vertex_parts: np.ndarray, visible_parts) -> np.ndarray:
+    """(V,) bool: the vertices whose part (``vertex_parts`` (V,), indices into
+    ``PART_NAMES``) is named in ``visible_parts``."""
+    return np.isin(vertex_parts, [PART_NAMES.index(name) for name in visible_parts])
 
 
 _CROSS = cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3))

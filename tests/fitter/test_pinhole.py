@@ -10,7 +10,7 @@ import pytest
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import to_upright
-from bodyfit.fitter.body_model import PART_NAMES, forward
+from bodyfit.fitter.body_model import forward
 from bodyfit.fitter.canvas import VIEW_PARTS, CanvasSettings, extreme_bodies
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.fit import placement_body
@@ -19,6 +19,7 @@ from bodyfit.fitter.pinhole_canvas import (Placement, phone_intrinsics, pinhole_
 from bodyfit.fitter.side_arms import side_photo_pose
 from bodyfit.fitter.stature import StatureConditioner
 from bodyfit.kernels import ModelArrays, PopulationEvaluator
+from bodyfit.kernels.target import visible_vertices
 from bodyfit.fitter.run import RUN_FILES
 from bodyfit.calib.silhouette import photo_silhouette
 from bodyfit.fitter.studio_photos import (BACKDROP_BGR, pinhole_photo, write_pinhole_photos,
@@ -111,7 +112,7 @@ def test_solved_distance_of_another_body(body_model, mean_body, tmp_path, distan
     body = mean_body.astype(np.float64) * (truth["O"] / 1000 / np.ptp(mean_body[:, 2]))
     for view in ("front", "side"):
         mask = person_mask(cv2.imread(str(tmp_path / f"{view}.png")))
-        shown = np.isin(body_model.vertex_parts, [PART_NAMES.index(p) for p in VIEW_PARTS[view]])
+        shown = visible_vertices(body_model.vertex_parts, VIEW_PARTS[view])
         placement = solve_placement(view, mask, K_TRUE, body[shown])
         assert placement.distance_m == pytest.approx(distance_m, rel=0.02), view
         assert placement.height_m == pytest.approx(height_m, abs=0.05), view
@@ -133,7 +134,7 @@ def test_placed_anew_from_the_persons_own_body(body_model, mean_body, tmp_path):
         target = pinhole_view(view, mask, K_TRUE, truth["O"] / 1000, extent, mean_body,
                               body_model.vertex_parts)
         body = forward(body_model, SUBJECT_BETAS[None], pose[None])[0].astype(np.float64)
-        shown = np.isin(body_model.vertex_parts, [PART_NAMES.index(p) for p in VIEW_PARTS[view]])
+        shown = visible_vertices(body_model.vertex_parts, VIEW_PARTS[view])
         anew = placed_anew(target, mask, K_TRUE, body[shown])
         k_canvas = camera_matrices(target.camera)[0]
         np.testing.assert_allclose(camera_matrices(anew.camera)[0], k_canvas)
@@ -241,8 +242,7 @@ def test_placement_rounds_place_the_camera_for_the_body_as_rendered(body_model, 
         target = pinhole_view(view, mask, K_TRUE, stature, bodies.reshape(-1, 3), mean_body,
                               body_model.vertex_parts)
         rows = np.nonzero(target.silhouette)[0]
-        shown = np.isin(body_model.vertex_parts,
-                        [PART_NAMES.index(p) for p in target.visible_parts])
+        shown = visible_vertices(body_model.vertex_parts, target.visible_parts)
         shown_px = {}
         for conditioned in (True, False):
             body = placement_body(body_model, candidate, pose, target, stature, conditioned)
