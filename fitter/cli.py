@@ -102,6 +102,9 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "60)")
     parser.add_argument("--seed", type=int, help="random seed (default 0)"
                         + ("; every subject uses it" if batch else ""))
+    parser.add_argument("--searches", type=int,
+                        help="independent searches (seeds SEED, SEED+1, ...) whose answers "
+                             "are averaged (default 2; --method paper: 1)")
     parser.add_argument("--free-stature", action="store_true", default=None,
                         help="search the first shape component like the others (the paper) "
                              "instead of solving it so every candidate stands as tall as the "

@@ -23,13 +23,14 @@ from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, 
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
-from bodyfit.fitter.search import SearchResult, SearchSettings, search
+from bodyfit.fitter.search import SearchResult, SearchSettings, averaged, search
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
 from bodyfit.fitter.weights import cost_settings
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "placement_body"]
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "placement_body",
+           "stature_conditioner"]
 
 _SPREAD_SHARE = 0.25
 _SPREAD_MIN = 3
@@ -92,12 +93,13 @@ class FitSettings:
 
 #: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
 #: docs/fitter.md "Choosing the defaults") and the paper's method exactly (Sections
-#: 3.3-3.4): its GA at 30 x 25 over all 20 betas and the 4 angles, Table 2's weights, the
-#: person -> model matching, the moments' alignment, its 512 px canvases.
+#: 3.3-3.4): one search, its GA at 30 x 25 over all 20 betas and the 4 angles, Table 2's
+#: weights, the person -> model matching, the moments' alignment, its 512 px canvases.
 METHODS = {
     "bodyfit": FitSettings(),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
-                                               generations=None, condition_stature=False),
+                                               generations=None, condition_stature=False,
+                                               searches=1),
                          canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
                          projection="orthographic",
                          render_cell_mm=0.0, placement_rounds=0),
@@ -166,6 +168,19 @@ def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
                              settings.device, **view_options)
 
 
+def stature_conditioner(model: BodyModel, settings: FitSettings, stature_m: float,
+                        bodies: np.ndarray) -> StatureConditioner | None:
+    """The fit's :class:`~bodyfit.fitter.stature.StatureConditioner` (None without
+    ``condition_stature``): on the rest stature, on the posed height for orthographic
+    canvases (scaled so that the person's silhouette is the stature tall). ``bodies``: the
+    search's extreme bodies (:func:`~bodyfit.fitter.canvas.extreme_bodies`)."""
+    s = settings.search
+    if not s.condition_stature:
+        return None
+    return StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies,
+                              posed=settings.projection == "orthographic")
+
+
 def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                    view: kernels.ViewTarget, stature_m: float,
                    condition_stature: bool) -> np.ndarray:
@@ -173,14 +188,15 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     (:func:`~bodyfit.fitter.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
     (4,) degrees): the parts the view shows, in the view's pose, as the kernels render it.
 
-    A candidate conditioned on the stature stands the stature tall *posed* (legs apart),
-    where the person stands a few millimetres lower: it is the person scaled by
-    stature / (stature - delta), and its camera must stand as much farther, so it is
-    taken as it is. Scaled to the rest stature instead (the person's own size), the
-    camera stood at the person's true distance and showed every candidate 0.2-0.7 % too
-    tall, and the search answered with bodies as much too thin (the chest 6 mm too small;
-    docs/accuracy.md, "Pushing the numbers"). Without the conditioning a candidate has
-    its own height, and the camera is placed for it scaled to the person's stature.
+    A candidate conditioned on the stature (:mod:`bodyfit.fitter.stature`) is taken as it
+    is: on the rest stature (pinhole views) it is the person's size. (Conditioned on the
+    posed height, it stands the stature tall with its legs apart, where the person stands a
+    few millimetres lower, so it is the person scaled by stature / (stature - delta) and
+    its camera must stand as much farther: scaled to the rest stature instead, the camera
+    stood at the person's distance and showed every candidate 0.2-0.7 % too tall, and the
+    search answered with bodies as much too thin; docs/accuracy.md, "Pushing the
+    numbers", step 11.) Without the conditioning a candidate has its own height, and the
+    camera is placed for it scaled to the person's stature.
     """
     body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
     if not condition_stature:
@@ -210,6 +226,42 @@ def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, set
         return True
 
     return place
+
+
+def _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner, settings,
+              progress) -> SearchResult:
+    """``settings.search.searches`` searches of the person (seeds ``seed``, ``seed + 1``,
+    ...), each from the views as ``views`` holds them (the cameras placed from the mean
+    body) with its own placement rounds; one search's result as it is, several averaged
+    (:func:`~bodyfit.fitter.search.averaged`): the mean of their genes (the first beta
+    solved anew from the stature), scored with the cameras placed from that body. Updates
+    ``views`` (and the evaluator) to the cameras the answer is scored with."""
+    s = settings.search
+    first_views = dict(views)
+    results = []
+    for i in range(s.searches):
+        views.update(first_views)
+        for view in views.values():
+            evaluator.replace_view(view)
+        replace = None
+        if settings.projection == "pinhole" and settings.placement_rounds:
+            replace = _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator,
+                                        settings)
+        results.append(search(evaluator, dataclasses.replace(s, seed=s.seed + i), conditioner,
+                              progress, replace))
+    if len(results) == 1:
+        return results[0]
+    pose = np.mean([r.pose_deg for r in results], axis=0)
+    betas = np.mean([r.betas for r in results], axis=0)
+    if conditioner is not None:
+        betas = conditioner.complete(betas[None, 1:], pose[None])[0]
+    if settings.projection == "pinhole" and settings.placement_rounds:
+        for name, view in views.items():
+            body = placement_body(model, betas, pose, view, stature_m, s.condition_stature)
+            views[name] = placed_anew(view, masks[name], intrinsics[name], body)
+            evaluator.replace_view(views[name])
+    scored = evaluator.evaluate(betas[None], pose[None])
+    return averaged(results, betas, pose, float(scored.costs[0]), scored.part_costs[0])
 
 
 # One BLAS thread for the whole fit: its matrices are small (CMA-ES's 24 x 24, the
@@ -251,22 +303,17 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                                                  s.components, settings.device)
     evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost,
                                            workers=settings.threads)
-    conditioner = None
-    if s.condition_stature:
-        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies)
-    replace = None
-    if settings.projection == "pinhole" and settings.placement_rounds:
-        replace = _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator,
-                                    settings)
+    conditioner = stature_conditioner(model, settings, stature_m, bodies)
     t1 = time.perf_counter()
-    result = search(evaluator, s, conditioner, progress, replace)
+    result = _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner,
+                       settings, progress)
     t2 = time.perf_counter()
     betas = result.betas[None]
     posed = forward(model, betas, result.pose_deg[None])[0]
     view_bodies = {name: forward(model, betas, view.view_pose(result.pose_deg[None]))[0]
                    for name, view in views.items()}
     rest = rest_shape(model, betas)[0][0]
-    if s.condition_stature:  # the fit stands as tall as the person's stature: rescale it
+    if s.condition_stature:  # posed height conditioned, or a first beta at its limit: rescale
         scale = stature_scale(rest, stature_m)
         posed, rest = posed * scale, rest * scale
     measurer = Measurer.from_model(model)

@@ -103,6 +103,8 @@ class OptimizerResult:
         population: (P, D) float64; the last generation told, as told.
         population_costs: (P,) float64; its costs (+inf for failed candidates).
         stop_reasons: ``Optimizer.stop()`` at the time; empty while running.
+        centre: (D,) float64, the centre of the optimiser's search distribution (CMA-ES:
+            its mean, cma's ``xfavorite``), or None where it keeps none (the GA).
     """
 
     best_candidate: np.ndarray
@@ -112,6 +114,7 @@ class OptimizerResult:
     population: np.ndarray
     population_costs: np.ndarray
     stop_reasons: dict[str, object]
+    centre: np.ndarray | None = None
 
 
 class Optimizer(abc.ABC):
@@ -225,7 +228,11 @@ class Optimizer(abc.ABC):
             best_candidate=self._best_candidate.copy(), best_cost=self._best_cost,
             evaluations=self._evaluations, generations=self.generation,
             population=self._population.copy(), population_costs=self._population_costs.copy(),
-            stop_reasons=self.stop())
+            stop_reasons=self.stop(), centre=self._centre())
+
+    def _centre(self) -> np.ndarray | None:
+        """(D,) the search distribution's centre in genes' units, or None (the default)."""
+        return None
 
     @abc.abstractmethod
     def _ask(self) -> np.ndarray:
@@ -527,14 +534,18 @@ class CmaEvolutionStrategy(Optimizer):
     def _normalise(self, x: np.ndarray) -> np.ndarray:
         return (x - self.lower) / (self.upper - self.lower)
 
+    def _genes(self, normalised) -> np.ndarray:
+        """Genes' units of normalised coordinates, clipped to the bounds (rounding only)."""
+        x = self.lower + np.asarray(normalised) * (self.upper - self.lower)
+        return np.clip(x, self.lower, self.upper)
+
     @property
     def population_size(self) -> int:
         return int(self._es.popsize)
 
     def _ask(self) -> np.ndarray:
         self._asked_normalised = self._es.ask()
-        x = self.lower + np.array(self._asked_normalised) * (self.upper - self.lower)
-        return np.clip(x, self.lower, self.upper)  # rounding only
+        return self._genes(self._asked_normalised)
 
     def _tell(self, candidates: np.ndarray, costs: np.ndarray) -> None:
         if not np.isfinite(costs).any():
@@ -554,6 +565,9 @@ class CmaEvolutionStrategy(Optimizer):
 
     def _stop_reasons(self) -> dict[str, object]:
         return dict(self._es.stop())
+
+    def _centre(self) -> np.ndarray:
+        return self._genes(self._es.result.xfavorite)
 
 
 # --------------------------------------------------------------------------- factory

@@ -24,7 +24,8 @@ __all__ = ["INPUT_OPTIONS", "SEARCH_OPTIONS", "base_settings", "fit_settings"]
 #: `fitter run`'s options that are fields of PersonInputs, and of SearchSettings.
 INPUT_OPTIONS = ("front", "side", "height_cm", "camera", "mask_front", "mask_side",
                  "background_front", "background_side", "sex")
-SEARCH_OPTIONS = ("optimizer", "population", "generations", "components", "seed")
+SEARCH_OPTIONS = ("optimizer", "population", "generations", "components", "seed",
+                  "searches")
 
 
 def base_settings(method: str | None, config: Path | None

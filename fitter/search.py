@@ -20,7 +20,7 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import POSE_NAMES
 from bodyfit.fitter.optimizers import OPTIMIZER_NAMES, make_optimizer
 
-__all__ = ["SearchSettings", "SearchResult", "search"]
+__all__ = ["SearchSettings", "SearchResult", "search", "averaged"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,6 +46,11 @@ class SearchSettings:
         condition_stature: solve each candidate's first beta so that it stands as tall as
             the person (:mod:`bodyfit.fitter.stature`) instead of searching it (the paper
             searches it).
+        searches: independent searches of each person (seeds ``seed``, ``seed + 1``, ...),
+            whose answers the fit averages (:func:`averaged`; the paper: 1). One search's
+            answer varies with its seed by about as much as its error (its cost's noise
+            floor is flat across millimetres of shape), so the mean of two is nearer the
+            truth (docs/accuracy.md, "Pushing the numbers", step 13).
     """
 
     optimizer: str = "cmaes"
@@ -58,6 +63,7 @@ class SearchSettings:
     sigma0: float = 0.1
     seed: int = 0
     condition_stature: bool = True
+    searches: int = 2
 
     def validate(self, stored_components: int) -> None:
         if self.optimizer not in OPTIMIZER_NAMES:
@@ -67,7 +73,8 @@ class SearchSettings:
             raise UserError(f"--components must be 1-{stored_components} (the components "
                             f"the body model stores), got {self.components}")
         for name, value, least in (("--population", self.population, 4),
-                                   ("--generations", self.generations, 1)):
+                                   ("--generations", self.generations, 1),
+                                   ("--searches", self.searches, 1)):
             if value is not None and value < least:
                 raise UserError(f"{name} must be at least {least}, got {value}")
         if not all(lo < hi for lo, hi in zip(self.pose_lower_deg, self.pose_upper_deg)):
@@ -97,10 +104,13 @@ class SearchResult:
     """The outcome of :func:`search`.
 
     Attributes:
-        betas: (K,) float64 best shape, standard deviations.
-        pose_deg: (4,) float64 best pose, degrees, ``POSE_NAMES`` order.
-        cost: the best cost, weighted millimetres.
-        part_costs: (11,) float32, the best candidate's terms (``kernels.TERM_NAMES``).
+        betas: (K,) float64 the search's answer, standard deviations: the centre of the
+            optimiser's distribution at the end where it keeps one (CMA-ES's mean: it
+            averages the last generations' best candidates, where the best candidate
+            ever scored is partly chosen by the raster's noise), else the best candidate.
+        pose_deg: (4,) float64 the answer's pose, degrees, ``POSE_NAMES`` order.
+        cost: the answer's cost, weighted millimetres.
+        part_costs: (11,) float32, the answer's terms (``kernels.TERM_NAMES``).
         best_costs, mean_costs: (G,) per generation, the best so far and the mean of the
             finite costs of that generation.
         best_betas: (G, K) per generation, the betas of the best candidate so far (the
@@ -181,11 +191,14 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
     result = optimizer.result
     if not np.isfinite(result.best_cost):
         raise UserError("no candidate body produced a silhouette; check the photos and masks")
-    best = result.best_candidate[None]
-    best_betas = betas_of(best)
-    scored = evaluator.evaluate(best_betas, best[:, k:])  # its per-term breakdown
+    # the centre, unless it draws no silhouette; the best candidate ever scored did
+    for answer in (c for c in (result.centre, result.best_candidate) if c is not None):
+        answer_betas = betas_of(answer[None])
+        scored = evaluator.evaluate(answer_betas, answer[None, k:])  # cost and terms
+        if np.isfinite(scored.costs[0]):
+            break
     return SearchResult(
-        betas=best_betas[0], pose_deg=best[0, k:], cost=result.best_cost,
+        betas=answer_betas[0], pose_deg=answer[k:], cost=float(scored.costs[0]),
         part_costs=scored.part_costs[0], best_costs=np.array(best_costs),
         best_betas=betas_of(np.array(best_genes)),
         mean_costs=np.array(mean_costs),
@@ -194,3 +207,33 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
         final_costs=result.population_costs, evaluations=result.evaluations,
         generations=result.generations, seconds=time.perf_counter() - start,
         stop_reasons=result.stop_reasons)
+
+
+def _padded(curves: list[np.ndarray]) -> np.ndarray:
+    """(S, G, ...) of S per-generation curves of up to G generations, each padded with its
+    last value (a search that stopped early stays where it ended)."""
+    length = max(len(c) for c in curves)
+    return np.stack([np.concatenate([c, np.repeat(c[-1:], length - len(c), axis=0)])
+                     for c in curves])
+
+
+def averaged(results: list[SearchResult], betas: np.ndarray, pose_deg: np.ndarray,
+             cost: float, part_costs: np.ndarray) -> SearchResult:
+    """One result for several searches of a person whose answers were averaged into
+    (``betas`` (K,), ``pose_deg`` (4,)), scored ``cost`` with ``part_costs`` (11,).
+
+    The per-generation curves are the searches' means (the best so far per generation:
+    the mean of each search's best betas, as the averaged answer is formed); the final
+    population is all of theirs; evaluations and seconds add up.
+    """
+    return SearchResult(
+        betas=betas, pose_deg=pose_deg, cost=cost, part_costs=part_costs,
+        best_costs=_padded([r.best_costs for r in results]).mean(axis=0),
+        mean_costs=_padded([r.mean_costs for r in results]).mean(axis=0),
+        best_betas=_padded([r.best_betas for r in results]).mean(axis=0),
+        final_genes=np.concatenate([r.final_genes for r in results]),
+        final_costs=np.concatenate([r.final_costs for r in results]),
+        evaluations=sum(r.evaluations for r in results),
+        generations=max(r.generations for r in results),
+        seconds=sum(r.seconds for r in results),
+        stop_reasons={k: v for r in results for k, v in r.stop_reasons.items()})

@@ -1,22 +1,31 @@
-"""Conditioning candidates on the known stature: every candidate stands as tall as the person.
+"""Conditioning candidates on the known stature: every candidate is as tall as the person.
 
-The canvas is scaled so that the person's standing silhouette is ``body_height_px`` tall
-at ``body_height_px / stature`` pixels per metre (:mod:`bodyfit.fitter.canvas`). Along
-the first shape component (mostly stature) the cost is steep: +-0.1 sigma costs as much
-as a whole sigma of most others, so a search spends its budget there. Here the first
-beta is not searched but solved, per candidate, so that the candidate's *posed* height
-(its silhouette's height: top of the head to the lowest sole, with its legs apart) equals
-the stature: every candidate then fills the person's silhouette height exactly, and the
-search is over the shape's other components and the pose.
+Along the first shape component (mostly stature) the cost is steep: +-0.1 sigma costs as
+much as a whole sigma of most others, so a search spends its budget there. Here the first
+beta is not searched but solved, per candidate, so that the candidate has the person's
+height, and the search is over the shape's other components and the pose. Which height
+(``posed``):
 
-A person standing with the legs apart is a few millimetres lower than their stature, so
-the fitted body stands ``stature`` tall where the person stands ``stature - delta``: it is
-the person scaled by ``stature / (stature - delta)``. :func:`stature_scale` undoes that: the
-fitted body is scaled uniformly so that its rest stature is the given one.
+- **the rest stature** (pinhole views, the default): the candidate's stature in the rest
+  pose, where stature is measured, equals the person's. The person's own body is then a
+  candidate (with their pose), and the camera placed for a candidate
+  (:func:`bodyfit.fitter.fit.placement_body`) shows it at the person's size.
+- **the posed height** (orthographic views): the candidate's silhouette height, top of
+  the head to the lowest sole with its legs apart, equals the stature, as the
+  orthographic canvas is scaled so that the person's silhouette is the stature tall
+  (:mod:`bodyfit.fitter.canvas`). A person standing with the legs apart is a few
+  millimetres lower than their stature, so such a candidate is the person scaled by
+  ``stature / (stature - delta)``; :func:`stature_scale` undoes that: the fitted body is
+  scaled uniformly so that its rest stature is the given one.
 
-The posed vertices are linear in the betas for a fixed pose (Eq. 1-3 with the rotations
-fixed), so the posed height is piecewise linear in the first beta; Newton steps on the
-vertices near the top and the bottom of the body converge in a few iterations.
+Conditioning on the posed height in pinhole views too (the default before) left every
+candidate 0.2-0.7 % taller than the person and changed its shape along the first
+component to get there; on the rest stature the in-space error fell (docs/accuracy.md,
+"Pushing the numbers", step 13).
+
+The vertices are linear in the betas for a fixed pose (Eq. 1-3 with the rotations
+fixed), so a height is piecewise linear in the first beta; Newton steps on the vertices
+near the top and the bottom of the body converge in a few iterations.
 """
 
 from __future__ import annotations
@@ -38,22 +47,25 @@ _ITERATIONS = 6
 
 
 class StatureConditioner:
-    """Solves each candidate's first beta so that its posed height is ``height_m``.
+    """Solves each candidate's first beta so that its height is ``height_m``.
 
     Args:
         model: the body model.
         num_betas: K, the betas of a full candidate.
-        height_m: the posed height every candidate must have, metres.
+        height_m: the height every candidate must have, metres.
         beta_limit: the solved beta is kept within +-this (a body that cannot reach the
             height inside it keeps the limit, and its silhouette's height then differs).
         bodies: (B, V, 3) metres, bodies spanning the search's shapes and poses
             (:func:`bodyfit.fitter.canvas.extreme_bodies`): the vertices near their highest
             and lowest points are the only ones a candidate's height is read from.
+        posed: condition the posed height (the silhouette's, orthographic views) instead
+            of the rest stature (module docstring).
     """
 
     def __init__(self, model: BodyModel, num_betas: int, height_m: float,
-                 beta_limit: float, bodies: np.ndarray):
+                 beta_limit: float, bodies: np.ndarray, *, posed: bool = False):
         self.num_betas = num_betas
+        self.posed = posed
         self.height_m = float(height_m)
         self.beta_limit = float(beta_limit)
         band = self._extreme_vertices(np.asarray(bodies)[..., 2])
@@ -70,8 +82,11 @@ class StatureConditioner:
         bottom = z <= z.min(axis=1, keepdims=True) + _EXTREME_BAND_M
         return np.flatnonzero((top | bottom).any(axis=0))
 
-    def _posed_z(self, betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
-        """(P, V') float64 posed heights of the extreme vertices, metres."""
+    def _z(self, betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
+        """(P, V') float64 heights of the extreme vertices, metres: posed, or in the rest
+        pose (zero angles) unless ``posed``."""
+        if not self.posed:
+            pose_deg = np.zeros_like(pose_deg)
         return forward(self._model, betas, pose_deg)[..., 2].astype(np.float64)
 
     def complete(self, other_betas: np.ndarray, pose_deg: np.ndarray) -> np.ndarray:
@@ -79,14 +94,14 @@ class StatureConditioner:
 
         Args:
             other_betas: (P, K - 1) betas 2..K, standard deviations.
-            pose_deg: (P, 4) degrees.
+            pose_deg: (P, 4) degrees (unused unless ``posed``).
         """
         other_betas = np.asarray(other_betas, np.float64)
-        # for a fixed pose the posed vertices are linear in the betas (Eq. 1-3 with the
+        # for a fixed pose the vertices are linear in the betas (Eq. 1-3 with the
         # rotations fixed), so the heights are base + first beta * slope
         zero = np.zeros((len(other_betas), 1))
-        base = self._posed_z(np.hstack([zero, other_betas]), pose_deg)  # (P, V')
-        slope = self._posed_z(np.hstack([zero + 1.0, other_betas]), pose_deg) - base
+        base = self._z(np.hstack([zero, other_betas]), pose_deg)  # (P, V')
+        slope = self._z(np.hstack([zero + 1.0, other_betas]), pose_deg) - base
         first = np.zeros(len(other_betas))
         rows = np.arange(len(first))
         for _ in range(_ITERATIONS):

@@ -26,11 +26,10 @@ import warp
 
 from bodyfit import kernels
 from bodyfit.fitter.canvas import extreme_bodies
-from bodyfit.fitter.fit import FitSettings, fit_person
+from bodyfit.fitter.fit import FitSettings, fit_person, stature_conditioner
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.person import PersonInputs, person_masks
-from bodyfit.fitter.stature import StatureConditioner
 from bodyfit.fitter.studio_photos import write_subject
 from bodyfit.fitter.weights import cost_settings
 from bench_subjects import draw_subject
@@ -58,10 +57,10 @@ def _variants(base: FitSettings) -> dict[str, FitSettings]:
 
 def _true_cost(model, fit, settings: FitSettings, betas, pose, stature_m) -> float:
     s = settings.search
-    if s.condition_stature:
-        bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
-                                s.beta_limit)
-        conditioner = StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies)
+    bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
+                            s.beta_limit)
+    conditioner = stature_conditioner(model, settings, stature_m, bodies)
+    if conditioner is not None:
         betas = conditioner.complete(betas[None, 1:], pose[None])[0]
     arrays = kernels.ModelArrays.from_body_model(model, s.components)
     evaluator = kernels.PopulationEvaluator(arrays, list(fit.views.values()), settings.cost)

@@ -368,3 +368,76 @@ def test_search_forgets_the_best_when_the_costs_change_meaning():
     assert seen == list(range(1, 9))
     assert np.all(result.best_costs[:4] < 100) and np.all(result.best_costs[4:] >= 100)
     assert result.cost >= 100 and len(result.best_betas) == 8
+
+
+def noisy_sphere(target, seed, noise=0.01):
+    """``sphere`` plus Gaussian noise of ``noise`` per candidate, like the raster's on a
+    body's cost: the best candidate ever told is partly the luckiest draw."""
+    rng = np.random.default_rng([seed, 123])
+    exact = sphere(target)
+    return lambda x: exact(x) + rng.normal(0.0, noise, len(x))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_cmaes_centre_is_nearer_a_noisy_minimum_than_the_best_candidate(seed):
+    target = inner_target(seed)
+    opt = make_optimizer("cmaes", LOWER, UPPER, population=30, generations=150, seed=seed)
+    run(opt, noisy_sphere(target, seed))
+    result = opt.result
+    assert np.all((result.centre >= LOWER) & (result.centre <= UPPER))
+    error = {name: np.sqrt(sphere(target)(x[None])[0])
+             for name, x in (("centre", result.centre), ("best", result.best_candidate))}
+    assert error["centre"] < error["best"], error
+
+
+def test_ga_keeps_no_centre():
+    opt = make_optimizer("ga", LOWER, UPPER, population=10, generations=2, seed=0)
+    run(opt, sphere(inner_target(0)))
+    assert opt.result.centre is None
+
+
+def test_search_answers_with_the_cmaes_centre_scored():
+    """The search's answer is CMA-ES's final mean, with its own cost and terms; on a noisy
+    cost it lies nearer the minimum than the best candidate scored (the last entry of
+    best_betas)."""
+    from types import SimpleNamespace
+
+    from bodyfit.fitter.search import SearchSettings, search
+
+    target = np.array([0.5, -1.0, 0.8])
+    rng = np.random.default_rng(5)
+
+    class Evaluator:
+        def evaluate(self, betas, pose_deg):
+            costs = np.sum((betas - target) ** 2, axis=1) + rng.normal(0, 0.05, len(betas))
+            return SimpleNamespace(costs=costs, part_costs=np.tile(costs[:, None], (1, 11)))
+
+    settings = SearchSettings(optimizer="cmaes", population=12, generations=80, components=3,
+                              condition_stature=False, seed=3)
+    result = search(Evaluator(), settings, progress=False)
+    assert np.linalg.norm(result.betas - target) < np.linalg.norm(
+        result.best_betas[-1] - target)
+    assert result.part_costs[0] == pytest.approx(result.cost)
+
+
+def test_averaged_searches_pad_average_and_add_up():
+    from bodyfit.fitter.search import SearchResult, averaged
+
+    def result(best_costs, betas, evaluations, population):
+        g = len(best_costs)
+        return SearchResult(
+            betas=np.zeros(2), pose_deg=np.zeros(4), cost=1.0, part_costs=np.zeros(11),
+            best_costs=np.array(best_costs, float), mean_costs=np.array(best_costs) + 1.0,
+            best_betas=np.tile(betas, (g, 1)), final_genes=np.full((population, 6), g, float),
+            final_costs=np.arange(population, dtype=float), evaluations=evaluations,
+            generations=g, seconds=2.0, stop_reasons={"generations": g})
+
+    one = result([5.0, 4.0, 3.0], [1.0, 2.0], 30, 3)
+    two = result([7.0, 5.0], [3.0, 0.0], 20, 2)  # stopped a generation early
+    both = averaged([one, two], np.array([2.0, 1.0]), np.ones(4), 9.0, np.full(11, 0.5))
+    np.testing.assert_allclose(both.best_costs, [6.0, 4.5, 4.0])
+    np.testing.assert_allclose(both.mean_costs, [7.0, 5.5, 5.0])
+    np.testing.assert_allclose(both.best_betas, [[2.0, 1.0]] * 3)
+    assert both.final_genes.shape == (5, 6) and len(both.final_costs) == 5
+    assert (both.evaluations, both.generations, both.seconds) == (50, 3, 4.0)
+    assert both.cost == 9.0 and both.betas.tolist() == [2.0, 1.0]

@@ -225,29 +225,36 @@ def test_a_camera_of_another_size_is_refused(body_model, tmp_path, capsys):
 
 def test_placement_rounds_place_the_camera_for_the_body_as_rendered(body_model, mean_body,
                                                                      tmp_path):
-    """A candidate conditioned on the stature stands the stature tall with its legs apart,
-    the person about 2 cm lower (12 degrees apart): the camera placed from
-    ``placement_body`` shows it as tall as the person's silhouette; placed from it scaled to
-    the rest stature (the person's own size, as before), it showed it 1 % too tall."""
+    """A candidate conditioned on the rest stature (the default) is the person (their betas
+    and pose): the camera placed from ``placement_body`` shows it as tall as the person's
+    silhouette. One conditioned on the posed height stands the stature tall with its legs
+    apart, the person about 2 cm lower (12 degrees apart): placed from it as rendered, the
+    camera shows it as tall as the person too; placed from it scaled to the rest stature
+    (the person's own size, as before step 11), it showed it 1 % too tall."""
     pose = np.array([5.0, 5.0, 12.0, 12.0])
     truth = write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, pose, K_TRUE, SIZE_PX,
                                   3.0, 1.2)
     stature = truth["O"] / 1000
     bodies = extreme_bodies(body_model, 20, [-5.0] * 4, [30.0] * 4)
-    candidate = StatureConditioner(body_model, 20, stature, 3.0, bodies).complete(
-        SUBJECT_BETAS[None, 1:], pose[None])[0]
-    rendered = forward(body_model, candidate[None], pose[None])[0].astype(np.float64)
+    candidates = {posed: StatureConditioner(body_model, 20, stature, 3.0, bodies, posed=posed
+                                            ).complete(SUBJECT_BETAS[None, 1:], pose[None])[0]
+                  for posed in (False, True)}
+    assert candidates[False][0] == pytest.approx(SUBJECT_BETAS[0], abs=2e-3)
+    assert candidates[True][0] - SUBJECT_BETAS[0] > 0.02
     for view in ("front", "side"):
         mask = person_mask(cv2.imread(str(tmp_path / f"{view}.png")))
         target = pinhole_view(view, mask, K_TRUE, stature, bodies.reshape(-1, 3), mean_body,
                               body_model.vertex_parts)
         rows = np.nonzero(target.silhouette)[0]
+        person_px = rows.max() - rows.min() + 1
         shown = visible_vertices(body_model.vertex_parts, target.visible_parts)
         shown_px = {}
-        for conditioned in (True, False):
+        for posed, conditioned in ((False, True), (True, True), (True, False)):
+            candidate = candidates[posed]
+            rendered = forward(body_model, candidate[None], pose[None])[0].astype(np.float64)
             body = placement_body(body_model, candidate, pose, target, stature, conditioned)
             k, r, t = camera_matrices(placed_anew(target, mask, K_TRUE, body).camera)
-            shown_px[conditioned] = np.ptp(project(k, r, t, rendered[shown])[:, 1])
-        person_px = rows.max() - rows.min() + 1
-        assert shown_px[True] == pytest.approx(person_px, abs=1.0), view
-        assert shown_px[False] - person_px > 0.008 * person_px, view
+            shown_px[posed, conditioned] = np.ptp(project(k, r, t, rendered[shown])[:, 1])
+        assert shown_px[False, True] == pytest.approx(person_px, abs=1.0), view
+        assert shown_px[True, True] == pytest.approx(person_px, abs=1.0), view
+        assert shown_px[True, False] - person_px > 0.008 * person_px, view

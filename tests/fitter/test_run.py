@@ -50,7 +50,8 @@ def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, cap
     record = json.loads((out / "run.json").read_text())
     assert record["settings"]["search"]["optimizer"] == "cmaes"
     assert record["settings"]["side_arms"] == "down"
-    assert record["result"]["evaluations"] == 24 * 30
+    assert record["settings"]["search"]["searches"] == 2
+    assert record["result"]["evaluations"] == 2 * 24 * 30  # two searches, averaged
     costs = record["result"]["best_cost_per_generation"]
     assert costs[-1] < costs[0] and all(np.diff(costs) <= 0)
     assert cv2.imread(str(out / "convergence.png")).shape == (480, 800, 3)
@@ -80,6 +81,32 @@ def test_same_seed_same_result(subject, tmp_path, capsys):
         assert code == 0, err
         runs.append(json.loads((tmp_path / name / "run.json").read_text())["result"])
     assert runs[0]["betas"] == runs[1]["betas"] and runs[0]["best_cost"] == runs[1]["best_cost"]
+
+
+def test_two_searches_answer_with_the_mean_of_their_answers(subject, tmp_path, capsys):
+    """--searches 2 (the default) with seed 4 answers with the mean pose and the mean of
+    betas 2..K of the single searches with seeds 4 and 5 (the first beta is solved anew
+    from the stature), scored by the kernels at its own cost."""
+    folder, truth = subject
+    budget = ["--population", "8", "--generations", "4"]
+    results = {}
+    for name, options in (("4", ["--searches", "1", "--seed", "4"]),
+                          ("5", ["--searches", "1", "--seed", "5"]),
+                          ("both", ["--seed", "4"])):
+        code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
+                           str(tmp_path / name), *budget, *options)
+        assert code == 0, err
+        results[name] = json.loads((tmp_path / name / "run.json").read_text())["result"]
+    single = [np.array(results[name]["betas"]) for name in ("4", "5")]
+    both = np.array(results["both"]["betas"])
+    np.testing.assert_allclose(both[1:], (single[0][1:] + single[1][1:]) / 2, atol=1e-6)
+    assert not np.allclose(single[0][1:], single[1][1:])
+    for joint, angle in results["both"]["pose_deg"].items():
+        assert angle == pytest.approx((results["4"]["pose_deg"][joint]
+                                       + results["5"]["pose_deg"][joint]) / 2)
+    assert results["both"]["evaluations"] == 2 * 8 * 4
+    assert sum(results["both"]["part_costs"].values()) == pytest.approx(
+        results["both"]["best_cost"], rel=1e-5)
 
 
 def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):

@@ -1,4 +1,5 @@
-"""Candidates conditioned on the stature: the solved first beta gives the posed height."""
+"""Candidates conditioned on the stature: the solved first beta gives the rest stature, or the
+posed height."""
 
 import numpy as np
 import pytest
@@ -19,7 +20,8 @@ def test_solved_first_beta_gives_the_posed_height(body_model, height_m):
     """Checked with the NumPy forward on every vertex (the solver sees only the extremes
     through its linear map)."""
     rng = np.random.default_rng(2)
-    conditioner = StatureConditioner(body_model, 20, height_m, 3.0, range_bodies(body_model))
+    conditioner = StatureConditioner(body_model, 20, height_m, 3.0, range_bodies(body_model),
+                                     posed=True)
     other, pose = rng.uniform(-1.5, 1.5, (12, 19)), rng.uniform(-10, 30, (12, 4))
     betas = conditioner.complete(other, pose)
     np.testing.assert_array_equal(betas[:, 1:], other)
@@ -29,6 +31,24 @@ def test_solved_first_beta_gives_the_posed_height(body_model, height_m):
     assert free.sum() >= 8
     np.testing.assert_allclose(heights[free], height_m, atol=2e-4)
     assert np.all(np.abs(heights[~free] - height_m) > 2e-4)
+
+
+@pytest.mark.parametrize("height_m", [1.55, 1.9])
+def test_solved_first_beta_gives_the_rest_stature_whatever_the_pose(body_model, height_m):
+    """The default: the rest body (NumPy, every vertex) is the stature tall; the pose does
+    not change the solved beta, and the same body posed with its legs apart is lower."""
+    rng = np.random.default_rng(3)
+    conditioner = StatureConditioner(body_model, 20, height_m, 3.0, range_bodies(body_model))
+    other, pose = rng.uniform(-1.5, 1.5, (12, 19)), rng.uniform(-10, 30, (12, 4))
+    betas = conditioner.complete(other, pose)
+    np.testing.assert_array_equal(betas, conditioner.complete(other, np.zeros_like(pose)))
+    free = np.abs(betas[:, 0]) < 3.0
+    assert free.sum() >= 6
+    rest, _ = rest_shape(body_model, betas[free])
+    np.testing.assert_allclose(np.ptp(rest[..., 2], axis=1), height_m, atol=2e-4)
+    apart = np.array([0.0, 0.0, 15.0, 15.0])
+    posed = forward(body_model, betas[free], np.tile(apart, (free.sum(), 1)))[..., 2]
+    assert np.all(np.ptp(posed, axis=1) < height_m - 2e-3)
 
 
 def test_unreachable_height_keeps_the_beta_limit(body_model):
