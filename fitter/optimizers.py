@@ -228,10 +228,12 @@ class Optimizer(abc.ABC):
             best_candidate=self._best_candidate.copy(), best_cost=self._best_cost,
             evaluations=self._evaluations, generations=self.generation,
             population=self._population.copy(), population_costs=self._population_costs.copy(),
-            stop_reasons=self.stop(), centre=self._centre())
+            stop_reasons=self.stop(), centre=self.centre)
 
-    def _centre(self) -> np.ndarray | None:
-        """(D,) the search distribution's centre in genes' units, or None (the default)."""
+    @property
+    def centre(self) -> np.ndarray | None:
+        """(D,) the search distribution's centre in genes' units, or None where the
+        optimiser keeps none (the default)."""
         return None
 
     @abc.abstractmethod
@@ -566,7 +568,8 @@ class CmaEvolutionStrategy(Optimizer):
     def _stop_reasons(self) -> dict[str, object]:
         return dict(self._es.stop())
 
-    def _centre(self) -> np.ndarray:
+    @property
+    def centre(self) -> np.ndarray:
         return self._genes(self._es.result.xfavorite)
 
 

@@ -113,8 +113,9 @@ class SearchResult:
         part_costs: (11,) float32, the answer's terms (``kernels.TERM_NAMES``).
         best_costs, mean_costs: (G,) per generation, the best so far and the mean of the
             finite costs of that generation.
-        best_betas: (G, K) per generation, the betas of the best candidate so far (the
-            first candidate until one is scored).
+        best_betas: (G, K) per generation, the betas the search would have answered with
+            had it stopped there: the optimiser's centre (CMA-ES), else the best candidate
+            so far (the first candidate until one is scored); the last is the answer's.
         final_genes: (P, K + 4) float64 the last population (all K betas, then the pose),
             ``final_costs`` (P,) its costs.
         evaluations: candidates scored; generations: G; seconds: wall time.
@@ -168,7 +169,7 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
     optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
                                population=settings.population, seed=settings.seed, **options)
     start = time.perf_counter()
-    best_costs, mean_costs, best_genes = [], [], []
+    best_costs, mean_costs, answers = [], [], []
     running = (np.inf, None)  # the best cost and genes scored so far
     with tqdm(desc=f"search ({settings.optimizer})", unit="gen", dynamic_ncols=True,
               disable=None if progress is None else not progress) as bar:
@@ -179,7 +180,9 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
             finite = costs[np.isfinite(costs)]
             if finite.size and finite.min() < running[0]:
                 running = (finite.min(), genes[np.flatnonzero(costs == finite.min())[0]])
-            best_genes.append(genes[0] if running[1] is None else running[1])
+            centre = optimizer.centre  # the answer had the search stopped here
+            answers.append(centre if centre is not None else
+                           genes[0] if running[1] is None else running[1])
             best_costs.append(optimizer.best_cost)
             mean_costs.append(float(finite.mean()) if finite.size else np.inf)
             bar.update(1)
@@ -200,7 +203,7 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
     return SearchResult(
         betas=answer_betas[0], pose_deg=answer[k:], cost=float(scored.costs[0]),
         part_costs=scored.part_costs[0], best_costs=np.array(best_costs),
-        best_betas=betas_of(np.array(best_genes)),
+        best_betas=betas_of(np.array(answers)),
         mean_costs=np.array(mean_costs),
         final_genes=np.concatenate([betas_of(result.population), result.population[:, k:]],
                                    axis=1),
@@ -222,8 +225,8 @@ def averaged(results: list[SearchResult], betas: np.ndarray, pose_deg: np.ndarra
     """One result for several searches of a person whose answers were averaged into
     (``betas`` (K,), ``pose_deg`` (4,)), scored ``cost`` with ``part_costs`` (11,).
 
-    The per-generation curves are the searches' means (the best so far per generation:
-    the mean of each search's best betas, as the averaged answer is formed); the final
+    The per-generation curves are the searches' means (``best_betas``: the mean of their
+    answers had they stopped there, as the averaged answer is formed); the final
     population is all of theirs; evaluations and seconds add up.
     """
     return SearchResult(

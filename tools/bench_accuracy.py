@@ -249,7 +249,7 @@ def figures(args) -> None:
         curves[label] = error_per_generation(model, bodies, run, generations, common)
         print(f"{label}: " + ", ".join(f"g{g} {e:.1f}" for g, e in zip(generations,
                                                                       curves[label])))
-    chart = line_chart(curves, f"{args.title}, {len(common)} subjects: the best so far",
+    chart = line_chart(curves, f"{args.title}, {len(common)} subjects: the answer so far",
                        "generation",
                        "7 important, mean abs. error (mm)",
                        x_values={label: generations for label in curves})

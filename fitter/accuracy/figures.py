@@ -1,8 +1,10 @@
 """The accuracy benchmark's figures: error per generation (the paper's Fig. 12) and fitted
 bodies coloured by their distance from the truth (its Figs. 16 and 17).
 
-Both start from a run's run.json files, which record the best candidate's betas after
-every generation (``best_betas_per_generation``), and the set's true bodies.
+Both start from a run's run.json files, which record after every generation the betas the
+search would have answered with had it stopped there (``best_betas_per_generation``:
+CMA-ES's mean, averaged over the searches; the GA's best candidate so far; the best
+candidate so far in runs before commit c5ea503), and the set's true bodies.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ __all__ = ["error_per_generation", "distance_panel", "colour_bar", "fitted_rest_
 
 def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
                  generations: list[int] | None = None) -> np.ndarray:
-    """(G, V, 3) the best rest body so far after each of ``generations`` (1-based; None:
+    """(G, V, 3) the rest body answered after each of ``generations`` (1-based; None:
     the last), as the fit measures it: stood as tall as the person when the run solved
     every candidate to the stature (``fitter.fit.fit_person``)."""
     record = json.loads((Path(run_folder) / subject / "run.json").read_text())
@@ -41,8 +43,8 @@ def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
 
 def error_per_generation(model: BodyModel, bodies: Bodies, run_folder: Path,
                          generations: list[int], subjects: set[str]) -> np.ndarray:
-    """(len(generations),) mean |error| (mm) of the 7 important measurements of the best
-    body so far after each of ``generations`` (1-based), over ``subjects`` (ids whose
+    """(len(generations),) mean |error| (mm) of the 7 important measurements of the body
+    answered after each of ``generations`` (1-based), over ``subjects`` (ids whose
     run.json the run has); ``bodies``: the set's (:func:`.subject_set.read_bodies`); the
     last generation's is the run's own error."""
     measurer = Measurer.from_model(model)

@@ -397,26 +397,30 @@ def test_ga_keeps_no_centre():
 
 
 def test_search_answers_with_the_cmaes_centre_scored():
-    """The search's answer is CMA-ES's final mean, with its own cost and terms; on a noisy
-    cost it lies nearer the minimum than the best candidate scored (the last entry of
-    best_betas)."""
+    """The search's answer is CMA-ES's final mean, with its own cost and terms, and the last
+    of the per-generation answers; on a noisy cost it lies nearer the minimum than the
+    best candidate scored."""
     from types import SimpleNamespace
 
     from bodyfit.fitter.search import SearchSettings, search
 
     target = np.array([0.5, -1.0, 0.8])
     rng = np.random.default_rng(5)
+    scored = []
 
     class Evaluator:
         def evaluate(self, betas, pose_deg):
             costs = np.sum((betas - target) ** 2, axis=1) + rng.normal(0, 0.05, len(betas))
+            scored.extend(zip(costs, betas.copy()))
             return SimpleNamespace(costs=costs, part_costs=np.tile(costs[:, None], (1, 11)))
 
     settings = SearchSettings(optimizer="cmaes", population=12, generations=80, components=3,
                               condition_stature=False, seed=3)
     result = search(Evaluator(), settings, progress=False)
-    assert np.linalg.norm(result.betas - target) < np.linalg.norm(
-        result.best_betas[-1] - target)
+    best = min(scored[:-1], key=lambda pair: pair[0])[1]  # the last scored is the answer
+    assert np.linalg.norm(result.betas - target) < np.linalg.norm(best - target)
+    np.testing.assert_array_equal(scored[-1][1], result.betas)
+    np.testing.assert_array_equal(result.best_betas[-1], result.betas)
     assert result.part_costs[0] == pytest.approx(result.cost)
 
 
