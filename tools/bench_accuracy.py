@@ -198,7 +198,7 @@ def report(args) -> None:
     ablations = [_run_spec(spec) for spec in args.ablation]
     table4 = {}
     for label, set_folder, run in mains:
-        scores = read_scores(set_folder, run)
+        scores = _first(read_scores(set_folder, run), set_folder, args.first)
         table4[label] = scores
         print(f"### {label}\n\n{_timing(scores, run)}.\n")
         print("\n".join(measurement_table(scores)) + "\n")
@@ -214,14 +214,20 @@ def report(args) -> None:
         baseline = first_of_set.setdefault(set_folder.resolve(), label)
         if baseline != label:
             baselines[label] = baseline
-        scores = read_scores(set_folder, run)
-        if args.first:  # the set's first N subjects (those of `fit --first N`)
-            rows = _table_rows(set_folder, args.first)[1:]
-            scores = _subset(scores, {row.split(",")[0] for row in rows})
+        scores = _first(read_scores(set_folder, run), set_folder, args.first)
         table4[label] = scores
         print(f"- {label}: {_timing(scores, run)}")
     print("\n### The 7 important measurements (Table 4 form)\n")
     print("\n".join(important_table(table4, baselines)))
+
+
+def _first(scores, set_folder: Path, first: int | None):
+    """The scores of the set's first ``first`` subjects (those of `fit --first N`); all
+    when None."""
+    if not first:
+        return scores
+    rows = _table_rows(set_folder, first)[1:]
+    return _subset(scores, {row.split(",")[0] for row in rows})
 
 
 def _subset(scores, ids: set[str]):
@@ -301,8 +307,8 @@ def main() -> None:
                    help="a run with its full Table 3 form")
     p.add_argument("--ablation", action="append", default=[], metavar="LABEL=SET:NAME",
                    help="a run in the Table 4 form only")
-    p.add_argument("--first", type=int, help="the ablations' rows over their set's first N "
-                   "subjects only (compare runs of `fit --first N` with a full run)")
+    p.add_argument("--first", type=int, help="every row over its set's first N subjects "
+                   "only (compare runs of `fit --first N` with a full run)")
     p = sub.add_parser("outlines", help="extracted silhouettes against the exact ones")
     p.add_argument("set")
     p.add_argument("--first", type=int, default=10, help="the set's first N subjects")

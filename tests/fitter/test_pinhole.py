@@ -186,7 +186,7 @@ def test_run_with_camera_writes_its_outputs(body_model, tmp_path, capsys):
     assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES)
     record = json.loads((out / "run.json").read_text())
     assert record["settings"]["projection"] == "pinhole"
-    assert record["result"]["evaluations"] == 16 * 8
+    assert record["result"]["evaluations"] == 2 * 16 * 8  # two searches
     stature = json.loads((out / "measurements.json").read_text())["measurements"]["stature"]
     assert abs(stature["value_mm"] - truth["O"]) < 40.0
 
