@@ -1,8 +1,8 @@
 """One person's fit: silhouettes -> canvases -> search -> body and measurements with spreads.
 
-The measurement spread: the final population's best quarter of candidates (at least
-three with a finite cost) are measured like the best body, and each measurement's
-spread is their standard deviation, millimetres. It says how well the photos pinned a
+The measurement spread: the best quarter of the searches' final populations, pooled (at
+least three with a finite cost), are measured like the fitted body, and each
+measurement's spread is their standard deviation, millimetres. It says how well the photos pinned a
 measurement down under this search: a measurement the silhouettes barely constrain
 varies among near-equal candidates. It is not a confidence interval; how often the
 truth falls inside it is for the accuracy benchmark to measure.

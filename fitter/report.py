@@ -124,7 +124,7 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
 <h1>bodyfit: fitted body and measurements</h1>
 <p class="note">bodyfit {_e(record["versions"].get("bodyfit", "?"))}, <code>fitter run</code>.
 The measurements are those of the fitted body model; the spread is their standard
-deviation over the final population's best quarter, not a confidence interval.</p>
+deviation over the best quarter of the searches' final populations, not a confidence interval.</p>
 <table>{_rows(given)}</table>
 
 <h2>Silhouettes</h2>
