@@ -205,10 +205,23 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     return body[shown].astype(np.float64)
 
 
+def _place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
+                   betas: np.ndarray, pose_deg: np.ndarray) -> None:
+    """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
+    degrees) as the kernels render it (:func:`placement_body`,
+    :func:`~bodyfit.fitter.pinhole_canvas.placed_anew`); updates ``views`` and the
+    evaluator."""
+    for name, view in views.items():
+        body = placement_body(model, betas, pose_deg, view, stature_m,
+                              settings.search.condition_stature)
+        views[name] = placed_anew(view, masks[name], intrinsics[name], body)
+        evaluator.replace_view(views[name])
+
+
 def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, settings):
     """The search's ``on_generation`` that places the pinhole cameras anew from the best
-    body so far (:func:`~bodyfit.fitter.pinhole_canvas.placed_anew`) after each of
-    ``settings.placement_rounds`` evenly spaced generations; it updates ``views`` too."""
+    body so far (:func:`_place_cameras`) after each of ``settings.placement_rounds``
+    evenly spaced generations."""
     generations = settings.search.generations or 1
     rounds = settings.placement_rounds
     # never after the last generation: its best must be scored with the cameras it ends with
@@ -218,11 +231,8 @@ def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, set
     def place(done: int, betas: np.ndarray, pose_deg: np.ndarray) -> bool:
         if done not in at:
             return False
-        for name, view in views.items():
-            body = placement_body(model, betas, pose_deg, view, stature_m,
-                                  settings.search.condition_stature)
-            views[name] = placed_anew(view, masks[name], intrinsics[name], body)
-            evaluator.replace_view(views[name])
+        _place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
+                       betas, pose_deg)
         return True
 
     return place
@@ -237,16 +247,15 @@ def _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner
     solved anew from the stature), scored with the cameras placed from that body. Updates
     ``views`` (and the evaluator) to the cameras the answer is scored with."""
     s = settings.search
+    placing = settings.projection == "pinhole" and settings.placement_rounds > 0
+    replace = (_placement_rounds(model, views, masks, intrinsics, stature_m, evaluator,
+                                 settings) if placing else None)
     first_views = dict(views)
     results = []
     for i in range(s.searches):
-        views.update(first_views)
+        views.update(first_views)  # each search starts from the mean body's cameras
         for view in views.values():
             evaluator.replace_view(view)
-        replace = None
-        if settings.projection == "pinhole" and settings.placement_rounds:
-            replace = _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator,
-                                        settings)
         results.append(search(evaluator, dataclasses.replace(s, seed=s.seed + i), conditioner,
                               progress, replace))
     if len(results) == 1:
@@ -255,11 +264,9 @@ def _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner
     betas = np.mean([r.betas for r in results], axis=0)
     if conditioner is not None:
         betas = conditioner.complete(betas[None, 1:], pose[None])[0]
-    if settings.projection == "pinhole" and settings.placement_rounds:
-        for name, view in views.items():
-            body = placement_body(model, betas, pose, view, stature_m, s.condition_stature)
-            views[name] = placed_anew(view, masks[name], intrinsics[name], body)
-            evaluator.replace_view(views[name])
+    if placing:
+        _place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
+                       betas, pose)
     scored = evaluator.evaluate(betas[None], pose[None])
     return averaged(results, betas, pose, float(scored.costs[0]), scored.part_costs[0])
 
