@@ -13,6 +13,8 @@
         --ablation "uniform weights=SETS/in:uniform-weights"
     # how far calib's extracted outlines lie from the exact silhouettes, per refinement passes
     python tools/bench_accuracy.py outlines SETS/in --first 10 --passes 1 2 4
+    # the space's floor: the error of each true body's closest body of K components
+    python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python tools/bench_accuracy.py figures SETS/in --curve "bodyfit=default" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -46,16 +48,17 @@ from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.fitter.accuracy.bodies import KINDS, pose_bodies
 from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, error_per_generation,
                                              fitted_rest_body)
-from bodyfit.fitter.accuracy.report import (failure_lines, important_table,
+from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean_of_important,
                                             measurement_table)
-from bodyfit.fitter.accuracy.scores import read_scores
+from bodyfit.fitter.accuracy.scores import KEYS, read_scores
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
-                                                 read_settings, subject_ids, write_bodies,
-                                                 write_photos_of_set)
-from bodyfit.fitter.body_model import PART_NAMES
+                                                 read_settings, read_truth, subject_ids,
+                                                 write_bodies, write_photos_of_set)
+from bodyfit.fitter.body_model import PART_NAMES, project_shape, rest_shape
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
+from bodyfit.fitter.stature import stature_scale
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
 
@@ -168,6 +171,35 @@ def outlines(args) -> None:
     for passes, values in offsets.items():
         outward, wrong = np.mean(values, axis=0)
         print(f"| {passes} | {outward:+.3f} | {wrong:.3f} |")
+
+
+def floor(args) -> None:
+    """The error no search over K components can go below: each true body's closest body
+    of the first K components (:func:`project_shape`: least squares over its vertices
+    and joints), rescaled to its stature as a fit is, measured against its truth. Prints
+    a Markdown row per K: the 7 important measurements' mean |error| with its 95 % CI,
+    over the hard share and the others (out-of-space), and each measurement's mean."""
+    folder = Path(args.set)
+    model = load_model()
+    bodies = read_bodies(model, folder)
+    ids = subject_ids(len(bodies.sex), bodies.sex)[:args.first]
+    truth = np.array([[read_truth(folder / i)[key] for key in KEYS] for i in ids])
+    stature_m = truth[:, KEYS.index("O")] / 1000.0
+    hard = bodies.hard[:len(ids)]
+    measurer = Measurer.from_model(model)
+    print(f"{folder}, the first {len(ids)} subjects: each true body's closest body of the "
+          "first K components, against its truth (mm)\n\n| K | 7 important (95 % CI) | "
+          "hard share | others | " + " | ".join(KEYS) + " |\n|" + "---|" * (len(KEYS) + 4))
+    for k in args.components:
+        rest, _ = rest_shape(model, project_shape(model, bodies.vertices[:len(ids)],
+                                                  bodies.joints[:len(ids)], k))
+        scaled = np.stack([body * stature_scale(body, s) for body, s in zip(rest, stature_m)])
+        errors = measurer.measure_many(scaled) - truth
+        mean, _, ci = mean_of_important(errors)
+        shares = [f"{mean_of_important(errors[rows])[0]:.2f}" if rows.any() else "-"
+                  for rows in (hard, ~hard)]
+        print(f"| {k} | {mean:.2f} (±{ci:.2f}) | {' | '.join(shares)} | "
+              + " | ".join(f"{v:.1f}" for v in np.abs(errors).mean(axis=0)) + " |")
 
 
 def _run_spec(spec: str) -> tuple[str, Path, Path]:
@@ -314,6 +346,10 @@ def main() -> None:
     p.add_argument("--first", type=int, default=10, help="the set's first N subjects")
     p.add_argument("--passes", type=int, nargs="+", default=[1, 2, 4],
                    help="outline refinement passes to compare (SilhouetteSettings.outline_passes)")
+    p = sub.add_parser("floor", help="the error of the truth's closest bodies of K components")
+    p.add_argument("set")
+    p.add_argument("--first", type=int, default=100, help="the set's first N subjects")
+    p.add_argument("--components", type=int, nargs="+", default=[20, 40, 60], metavar="K")
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
@@ -329,7 +365,7 @@ def main() -> None:
     if args.command == "fit":
         fit(args, batch_options)
     else:
-        {"make": make, "report": report, "outlines": outlines,
+        {"make": make, "report": report, "outlines": outlines, "floor": floor,
          "figures": figures}[args.command](args)
 
 

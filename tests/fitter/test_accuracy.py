@@ -142,6 +142,12 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     printed = tool("outlines", str(subject_set), "--first", "2", "--passes", "1", "4")
     outward = {int(m[1]): float(m[2]) for m in re.finditer(r"\| (\d) \| ([-+.\d]+) \|", printed)}
     assert abs(outward[4]) < 0.1 and outward[1] > 0.15
+    # the space's floor: in-space bodies are drawn from the first 20 components, so their
+    # closest bodies of 20 are themselves (round trip, up to the stored offsets' rounding);
+    # with 5 components millimetres are lost
+    printed = tool("floor", str(subject_set), "--first", "4", "--components", "5", "20")
+    floor = {int(m[1]): float(m[2]) for m in re.finditer(r"\| (\d+) \| ([.\d]+) \(", printed)}
+    assert floor[20] < 0.05 and floor[5] > 1.0
 
 
 def test_failures_are_counted_by_reason():
