@@ -105,6 +105,12 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     parser.add_argument("--searches", type=int,
                         help="independent searches (seeds SEED, SEED+1, ...) whose answers "
                              "are averaged (default 2; --method paper: 1)")
+    parser.add_argument("--refine-components", type=int, metavar="K",
+                        help="after the searches, refine their answer with CMA-ES over the "
+                             "first K components (more than --components; default 0: no "
+                             "refinement)")
+    parser.add_argument("--refine-generations", type=int,
+                        help="the refinement's generations (default 250)")
     parser.add_argument("--free-stature", action="store_true", default=None,
                         help="search the first shape component like the others (the paper) "
                              "instead of solving it so every candidate stands as tall as the "

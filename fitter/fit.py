@@ -23,7 +23,7 @@ from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, 
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
-from bodyfit.fitter.search import SearchResult, SearchSettings, averaged, search
+from bodyfit.fitter.search import SearchResult, SearchSettings, averaged, refined, search
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
 from bodyfit.fitter.weights import cost_settings
@@ -181,6 +181,18 @@ def stature_conditioner(model: BodyModel, settings: FitSettings, stature_m: floa
                               posed=settings.projection == "orthographic")
 
 
+def _scoring(model: BodyModel, views: dict[str, kernels.ViewTarget], settings: FitSettings,
+             stature_m: float, bodies: np.ndarray):
+    """(the kernels' evaluator over ``views``, the stature conditioner or None) for the
+    ``settings.search.components`` of a candidate; ``bodies``: the search's extreme bodies
+    over those components."""
+    arrays = kernels.ModelArrays.from_body_model(render_model(model, settings.render_cell_mm),
+                                                 settings.search.components, settings.device)
+    evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost,
+                                           workers=settings.threads)
+    return evaluator, stature_conditioner(model, settings, stature_m, bodies)
+
+
 def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                    view: kernels.ViewTarget, stature_m: float,
                    condition_stature: bool) -> np.ndarray:
@@ -271,6 +283,22 @@ def _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner
     return averaged(results, betas, pose, float(scored.costs[0]), scored.part_costs[0])
 
 
+def _refined(model, views, stature_m, first: SearchResult, settings, progress) -> SearchResult:
+    """The refinement search (``SearchSettings.refine_components``) from ``first``'s answer,
+    with the cameras ``first`` left in ``views``; joined to ``first`` by
+    :func:`~bodyfit.fitter.search.refined`."""
+    s = settings.search
+    refinement = s.refinement()
+    bodies = extreme_bodies(model, refinement.components, s.pose_lower_deg, s.pose_upper_deg,
+                            settings.canvas.beta_limit)
+    evaluator, conditioner = _scoring(model, views, dataclasses.replace(settings,
+                                                                        search=refinement),
+                                      stature_m, bodies)
+    betas = np.r_[first.betas, np.zeros(refinement.components - len(first.betas))]
+    start = np.r_[betas[len(betas) - refinement.searched_betas:], first.pose_deg]
+    return refined(first, search(evaluator, refinement, conditioner, progress, start=start))
+
+
 # One BLAS thread for the whole fit: its matrices are small (CMA-ES's 24 x 24, the
 # conditioner's, the forward's), and OpenBLAS's idle threads spin on the cores the
 # kernels' threads evaluate the population on (one fit: 22.5 -> 14.9 s with the search
@@ -306,14 +334,12 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     views = {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m, extent,
                          mean_body, model, settings, options[name])
              for name in ("front", "side")}
-    arrays = kernels.ModelArrays.from_body_model(render_model(model, settings.render_cell_mm),
-                                                 s.components, settings.device)
-    evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost,
-                                           workers=settings.threads)
-    conditioner = stature_conditioner(model, settings, stature_m, bodies)
+    evaluator, conditioner = _scoring(model, views, settings, stature_m, bodies)
     t1 = time.perf_counter()
     result = _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner,
                        settings, progress)
+    if s.refine_components:
+        result = _refined(model, views, stature_m, result, settings, progress)
     t2 = time.perf_counter()
     betas = result.betas[None]
     posed = forward(model, betas, result.pose_deg[None])[0]

@@ -86,6 +86,9 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
         ("generations", f"{_e(search['generations'] or default)} "
                         f"(ran {result['generations']}, {result['evaluations']} candidates)"),
         ("components", _e(search["components"])),
+        ("refinement", f"{_e(search['refine_components'])} components, "
+                       f"{_e(search['refine_generations'])} generations"
+         if search.get("refine_components") else "none"),
         ("matching", _e(cost["matching"])),
         ("seed", _e(search["seed"])),
         ("device", _e(record["settings"]["device"])),

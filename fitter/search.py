@@ -20,7 +20,13 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import POSE_NAMES
 from bodyfit.fitter.optimizers import OPTIMIZER_NAMES, make_optimizer
 
-__all__ = ["SearchSettings", "SearchResult", "search", "averaged"]
+__all__ = ["SearchSettings", "SearchResult", "search", "averaged", "refined", "REFINE_SIGMA0"]
+
+#: The refinement's initial step (``SearchSettings.refine_components``), a fraction of every
+#: gene's range: 0.5 sd of a beta, 3 degrees of an angle (on the first 20 out-of-space
+#: subjects, 0.05 for 100 generations gained 0.2 mm, 0.08 for 250 gained 2.0:
+#: docs/accuracy.md, step 14).
+REFINE_SIGMA0 = 0.08
 
 
 @dataclasses.dataclass(frozen=True)
@@ -51,6 +57,13 @@ class SearchSettings:
             answer varies with its seed by about as much as its error (its cost's noise
             floor is flat across millimetres of shape), so the mean of two is nearer the
             truth (docs/accuracy.md, "Pushing the numbers", step 13).
+        refine_components: K' > K: after the searches, one more search, CMA-ES's, over the
+            first K' components and the angles, started from the searches' answer (the
+            components past K at 0) with a step of ``REFINE_SIGMA0``, for
+            ``refine_generations`` generations of ``population``; the components past K
+            carry the shape K cannot (with K = 20, 7.1 mm of the 7 important measurements
+            of real bodies; docs/accuracy.md, "Pushing the numbers", step 14). 0: none.
+        refine_generations: the refinement's generations.
     """
 
     optimizer: str = "cmaes"
@@ -64,6 +77,8 @@ class SearchSettings:
     seed: int = 0
     condition_stature: bool = True
     searches: int = 2
+    refine_components: int = 0
+    refine_generations: int = 250
 
     def validate(self, stored_components: int) -> None:
         if self.optimizer not in OPTIMIZER_NAMES:
@@ -72,9 +87,15 @@ class SearchSettings:
         if not 1 <= self.components <= stored_components:
             raise UserError(f"--components must be 1-{stored_components} (the components "
                             f"the body model stores), got {self.components}")
+        if self.refine_components and not (self.components < self.refine_components
+                                           <= stored_components):
+            raise UserError(f"--refine-components must be 0 or {self.components + 1}-"
+                            f"{stored_components} (more than --components, at most those "
+                            f"the body model stores), got {self.refine_components}")
         for name, value, least in (("--population", self.population, 4),
                                    ("--generations", self.generations, 1),
-                                   ("--searches", self.searches, 1)):
+                                   ("--searches", self.searches, 1),
+                                   ("--refine-generations", self.refine_generations, 1)):
             if value is not None and value < least:
                 raise UserError(f"{name} must be at least {least}, got {value}")
         if not all(lo < hi for lo, hi in zip(self.pose_lower_deg, self.pose_upper_deg)):
@@ -82,6 +103,12 @@ class SearchSettings:
         if not 0 < self.sigma0 <= 1:
             raise UserError(f"sigma0 must be in (0, 1], a fraction of each gene's range, "
                             f"got {self.sigma0}")
+
+    def refinement(self) -> "SearchSettings":
+        """The settings of the refinement search (``refine_components``)."""
+        return dataclasses.replace(self, optimizer="cmaes", components=self.refine_components,
+                                   generations=self.refine_generations, sigma0=REFINE_SIGMA0,
+                                   searches=1, refine_components=0)
 
     @property
     def searched_betas(self) -> int:
@@ -138,7 +165,8 @@ class SearchResult:
 
 
 def search(evaluator, settings: SearchSettings, conditioner=None,
-           progress: bool | None = None, on_generation=None) -> SearchResult:
+           progress: bool | None = None, on_generation=None,
+           start: np.ndarray | None = None) -> SearchResult:
     """Search the body space against the evaluator's views.
 
     Args:
@@ -153,6 +181,8 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
             best candidate's betas (K,), its pose (4,)); when it returns True, the costs
             from the next generation on are not comparable with the earlier ones (it moved
             the evaluator's cameras), and the best so far is forgotten.
+        start: None, or (searched betas + 4,) genes CMA-ES's distribution starts from
+            (clipped to the bounds); None: the middle of the bounds (the mean body).
     """
     k = settings.searched_betas
     if settings.condition_stature and conditioner is None:
@@ -166,6 +196,10 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
     options = {} if settings.generations is None else {"generations": settings.generations}
     if settings.optimizer == "cmaes":
         options["sigma0"] = settings.sigma0
+        if start is not None:
+            options["x0"] = tuple(np.clip(start, settings.lower, settings.upper))
+    elif start is not None:
+        raise ValueError("only CMA-ES starts from given genes")
     optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
                                population=settings.population, seed=settings.seed, **options)
     start = time.perf_counter()
@@ -240,3 +274,29 @@ def averaged(results: list[SearchResult], betas: np.ndarray, pose_deg: np.ndarra
         generations=max(r.generations for r in results),
         seconds=sum(r.seconds for r in results),
         stop_reasons={k: v for r in results for k, v in r.stop_reasons.items()})
+
+
+def refined(first: SearchResult, refinement: SearchResult) -> SearchResult:
+    """One result for a search (or searches averaged) ``first`` over K components followed
+    by its ``refinement`` over K' > K: the refinement's answer; the per-generation curves
+    one after the other (``first``'s betas padded with zeros to K'); both final
+    populations (for the spreads); evaluations, generations and seconds added up."""
+    def padded(betas: np.ndarray) -> np.ndarray:
+        width = [(0, 0)] * (betas.ndim - 1) + [(0, len(refinement.betas) - betas.shape[-1])]
+        return np.pad(betas, width)
+
+    k = len(first.betas)
+    first_genes = np.concatenate([padded(first.final_genes[:, :k]), first.final_genes[:, k:]],
+                                 axis=1)
+    return dataclasses.replace(
+        refinement,
+        best_costs=np.concatenate([first.best_costs, refinement.best_costs]),
+        mean_costs=np.concatenate([first.mean_costs, refinement.mean_costs]),
+        best_betas=np.concatenate([padded(first.best_betas), refinement.best_betas]),
+        final_genes=np.concatenate([first_genes, refinement.final_genes]),
+        final_costs=np.concatenate([first.final_costs, refinement.final_costs]),
+        evaluations=first.evaluations + refinement.evaluations,
+        generations=first.generations + refinement.generations,
+        seconds=first.seconds + refinement.seconds,
+        stop_reasons={**first.stop_reasons, **{f"refinement {reason}": value for reason, value
+                                               in refinement.stop_reasons.items()}})

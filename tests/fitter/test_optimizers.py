@@ -2,6 +2,7 @@
 both optimisers, reproducibility, and the analytic case of a shifted sphere (the minimum
 is known). No body model: the costs are written here."""
 
+import dataclasses
 import doctest
 
 import numpy as np
@@ -445,3 +446,56 @@ def test_averaged_searches_pad_average_and_add_up():
     assert both.final_genes.shape == (5, 6) and len(both.final_costs) == 5
     assert (both.evaluations, both.generations, both.seconds) == (50, 3, 4.0)
     assert both.cost == 9.0 and both.betas.tolist() == [2.0, 1.0]
+
+
+def test_refined_search_joins_the_curves_and_pads_the_first_betas():
+    from bodyfit.fitter.search import SearchResult, refined
+
+    def result(k, generations, population, value):
+        return SearchResult(
+            betas=np.full(k, value), pose_deg=np.full(4, value), cost=value,
+            part_costs=np.zeros(11), best_costs=np.full(generations, value),
+            mean_costs=np.full(generations, value + 1.0),
+            best_betas=np.full((generations, k), value),
+            final_genes=np.full((population, k + 4), value),
+            final_costs=np.full(population, value), evaluations=generations * population,
+            generations=generations, seconds=value, stop_reasons={"generations": generations})
+
+    first, refinement = result(2, 3, 4, 1.0), result(5, 2, 6, 2.0)
+    joined = refined(first, refinement)
+    assert joined.betas.tolist() == [2.0] * 5 and joined.cost == 2.0
+    assert joined.best_costs.tolist() == [1.0, 1.0, 1.0, 2.0, 2.0]
+    np.testing.assert_array_equal(joined.best_betas[:3], [[1.0, 1.0, 0.0, 0.0, 0.0]] * 3)
+    np.testing.assert_array_equal(joined.best_betas[3:], np.full((2, 5), 2.0))
+    # the first's final genes: its betas padded with zero components, then its angles
+    np.testing.assert_array_equal(joined.final_genes[:4], [[1, 1, 0, 0, 0, 1, 1, 1, 1]] * 4)
+    assert joined.final_genes.shape == (10, 9) and len(joined.final_costs) == 10
+    assert (joined.evaluations, joined.generations, joined.seconds) == (24, 5, 3.0)
+    assert joined.stop_reasons == {"generations": 3, "refinement generations": 2}
+
+
+def test_search_starts_cmaes_from_the_given_genes():
+    """A start far from the middle of the bounds: the first generation is drawn around it
+    (sigma0 0.01 of the ranges), and a GA, which keeps no distribution, refuses one."""
+    from types import SimpleNamespace
+
+    from bodyfit.fitter.search import SearchSettings, search
+
+    asked = []
+
+    class Evaluator:
+        def evaluate(self, betas, pose_deg):
+            asked.append(np.concatenate([betas, pose_deg], axis=1))
+            costs = np.sum(betas ** 2, axis=1)
+            return SimpleNamespace(costs=costs, part_costs=np.tile(costs[:, None], (1, 11)))
+
+    start = np.array([2.0, -1.5, 0.5, 20.0, 25.0, -5.0, 10.0])
+    settings = SearchSettings(population=20, generations=1, components=3,
+                              condition_stature=False, sigma0=0.01)
+    search(Evaluator(), settings, progress=False, start=start)
+    ranges = settings.upper - settings.lower
+    np.testing.assert_allclose(asked[0].mean(axis=0), start, atol=0.02 * ranges.max())
+    assert np.all(np.abs(asked[0] - start) < 0.05 * ranges)
+    with pytest.raises(ValueError, match="only CMA-ES"):
+        search(Evaluator(), dataclasses.replace(settings, optimizer="ga"), progress=False,
+               start=start)

@@ -109,6 +109,33 @@ def test_two_searches_answer_with_the_mean_of_their_answers(subject, tmp_path, c
         results["both"]["best_cost"], rel=1e-5)
 
 
+def test_refinement_continues_from_the_searches_over_more_components(subject, tmp_path,
+                                                                     capsys):
+    """--refine-components 24: the searches run as without it (their curves and
+    per-generation answers the same, the answers padded with zero components), then the
+    refinement's generations follow; the answer has 24 components, scored at its cost."""
+    folder, truth = subject
+    budget = ["--population", "8", "--generations", "4", "--seed", "4"]
+    results = {}
+    for name, options in (("searches", []),
+                          ("refined", ["--refine-components", "24", "--refine-generations",
+                                       "3"])):
+        code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
+                           str(tmp_path / name), *budget, *options)
+        assert code == 0, err
+        results[name] = json.loads((tmp_path / name / "run.json").read_text())["result"]
+    searches, refined = results["searches"], results["refined"]
+    assert len(refined["betas"]) == 24 and len(searches["betas"]) == 20
+    assert refined["evaluations"] == 2 * 8 * 4 + 8 * 3 and refined["generations"] == 7
+    assert refined["best_cost_per_generation"][:4] == searches["best_cost_per_generation"]
+    answers = np.array(refined["best_betas_per_generation"])
+    np.testing.assert_allclose(answers[:4, :20], searches["best_betas_per_generation"])
+    assert not answers[:4, 20:].any() and answers[4:, 20:].any()
+    assert sum(refined["part_costs"].values()) == pytest.approx(refined["best_cost"],
+                                                                rel=1e-5)
+    assert "24 components, 3 generations" in (tmp_path / "refined" / "report.html").read_text()
+
+
 def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     folder, truth = subject
     budget = ["--optimizer", "ga", "--population", "8", "--generations", "1"]
@@ -132,6 +159,7 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--weights": "heavy"}, "heavy"),
     ({"--optimizer": "sgd"}, "invalid choice"),
     ({"--components": "99"}, "components"),
+    ({"--refine-components": "20"}, "refine-components must be 0 or 21-"),
     ({"--matching": "both"}, "matching"),
     ({"--side-arms": "up"}, "invalid choice"),
     ({"--threads": "0"}, "--threads"),
