@@ -107,11 +107,16 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
     intrinsics = view_intrinsics(inputs, masks) if settings.projection == "pinhole" else None
     fit = fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics)
     result = fit.search
-    searches = settings.search.searches
+    s = settings.search
+    if s.refine_components:  # short enough to clear the axis label
+        title = (f"{s.optimizer}: {result.evaluations} candidates, "
+                 + (f"{s.searches} searches' mean, " if s.searches > 1 else "")
+                 + f"refined at K={s.refine_components}")
+    else:
+        title = (f"search: {s.optimizer}, {result.evaluations} candidates"
+                 + (f" in {s.searches} searches (their mean)" if s.searches > 1 else ""))
     chart = line_chart({"best so far": result.best_costs, "generation mean": result.mean_costs},
-                       f"search: {settings.search.optimizer}, {result.evaluations} candidates"
-                       + (f" in {searches} searches (their mean)" if searches > 1 else ""),
-                       "generation", "cost (weighted mm)", log_y=True)
+                       title, "generation", "cost (weighted mm)", log_y=True)
     with staged_directory(out_dir) as stage:
         for name, vertices in (("mesh.obj", fit.posed), ("mesh.ply", fit.posed),
                                ("mesh_rest.ply", fit.rest)):
