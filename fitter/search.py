@@ -25,7 +25,7 @@ __all__ = ["SearchSettings", "SearchResult", "search", "averaged", "refined", "R
 #: The refinement's initial step (``SearchSettings.refine_components``), a fraction of every
 #: gene's range: 0.5 sd of a beta, 3 degrees of an angle (on the first 20 out-of-space
 #: subjects, 0.05 for 100 generations gained 0.2 mm, 0.08 for 250 gained 2.0:
-#: docs/accuracy.md, step 14).
+#: docs/accuracy.md, step 14). Not tuned further.
 REFINE_SIGMA0 = 0.08
 
 
