@@ -202,7 +202,7 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
         raise ValueError("only CMA-ES starts from given genes")
     optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
                                population=settings.population, seed=settings.seed, **options)
-    start = time.perf_counter()
+    began = time.perf_counter()
     best_costs, mean_costs, answers = [], [], []
     running = (np.inf, None)  # the best cost and genes scored so far
     with tqdm(desc=f"search ({settings.optimizer})", unit="gen", dynamic_ncols=True,
@@ -242,7 +242,7 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
         final_genes=np.concatenate([betas_of(result.population), result.population[:, k:]],
                                    axis=1),
         final_costs=result.population_costs, evaluations=result.evaluations,
-        generations=result.generations, seconds=time.perf_counter() - start,
+        generations=result.generations, seconds=time.perf_counter() - began,
         stop_reasons=result.stop_reasons)
 
 
