@@ -119,6 +119,8 @@ def stature_scale(rest_vertices: np.ndarray, stature_m: float) -> float:
     return float(stature_m / np.ptp(rest_vertices[:, 2]))
 
 
-def scaled_to_stature(rest_bodies: np.ndarray, stature_m: float) -> np.ndarray:
-    """(N, V, 3) rest bodies, each scaled by its own :func:`stature_scale` to ``stature_m``."""
-    return np.stack([body * stature_scale(body, stature_m) for body in rest_bodies])
+def scaled_to_stature(rest_bodies: np.ndarray, stature_m) -> np.ndarray:
+    """(N, V, 3) rest bodies, each scaled by its own :func:`stature_scale` to ``stature_m``
+    (metres: one for all, or (N,) one per body)."""
+    statures = np.broadcast_to(np.asarray(stature_m, dtype=np.float64), (len(rest_bodies),))
+    return np.stack([body * stature_scale(body, s) for body, s in zip(rest_bodies, statures)])

@@ -58,7 +58,7 @@ from bodyfit.fitter.body_model import PART_NAMES, project_shape, rest_shape
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
-from bodyfit.fitter.stature import stature_scale
+from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
 
@@ -193,8 +193,7 @@ def floor(args) -> None:
     for k in args.components:
         rest, _ = rest_shape(model, project_shape(model, bodies.vertices[:len(ids)],
                                                   bodies.joints[:len(ids)], k))
-        scaled = np.stack([body * stature_scale(body, s) for body, s in zip(rest, stature_m)])
-        errors = measurer.measure_many(scaled) - truth
+        errors = measurer.measure_many(scaled_to_stature(rest, stature_m)) - truth
         mean, _, ci = mean_of_important(errors)
         shares = [f"{mean_of_important(errors[rows])[0]:.2f}" if rows.any() else "-"
                   for rows in (hard, ~hard)]

@@ -68,6 +68,8 @@ def test_scaled_to_stature_scales_each_body_by_its_own_factor(body_model):
     scaled = scaled_to_stature(rest, 1.8)
     assert np.ptp(scaled[:, :, 2], axis=1) == pytest.approx([1.8, 1.8])
     assert scaled[1] == pytest.approx(rest[1] * stature_scale(rest[1], 1.8))
+    each = scaled_to_stature(rest, np.array([1.6, 1.9]))  # one stature per body
+    assert np.ptp(each[:, :, 2], axis=1) == pytest.approx([1.6, 1.9])
 
 
 def test_conditioned_search_leaves_the_first_beta_out_of_the_genes():
