@@ -107,10 +107,11 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "are averaged (default 2; --method paper: 1)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
-                             "first K components (more than --components; default 0: no "
-                             "refinement)")
+                             "first K components, as many refinements as searches, averaged "
+                             "(more than --components; default 40, none when --components "
+                             "is 40 or more; 0: none; --method paper: 0)")
     parser.add_argument("--refine-generations", type=int,
-                        help="the refinement's generations (default 250)")
+                        help="each refinement's generations (default 250)")
     parser.add_argument("--free-stature", action="store_true", default=None,
                         help="search the first shape component like the others (the paper) "
                              "instead of solving it so every candidate stands as tall as the "
@@ -166,7 +167,8 @@ def _build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--seed", type=int, default=0,
                       help="which body, camera place and board poses are drawn (default 0)")
     demo.add_argument("--generations", type=int, metavar="G",
-                      help="the search's generations (default: fitter run's)")
+                      help="the searches' and the refinements' generations (default: "
+                           "fitter run's)")
 
     run = sub.add_parser(
         "run", help="fit the body model to a person's front and side photos: mesh (m), "
@@ -287,7 +289,8 @@ def _cmd_demo(args) -> None:
                 "--height-cm", f"{scene.truth['O'] / 10:.1f}", "--camera", str(camera_path),
                 "-o", str(args.output / "fit"), "--overwrite"]
     if args.generations is not None:
-        run_argv += ["--generations", str(args.generations)]
+        run_argv += ["--generations", str(args.generations),
+                     "--refine-generations", str(args.generations)]
     run_args = _build_parser().parse_args(run_argv)
     inputs, settings, output = _run_settings(run_args)
     fit, written = run_person(model, inputs, settings, output, run_args.overwrite,

@@ -11,6 +11,7 @@ truth falls inside it is for the accuracy benchmark to measure.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import time
 
 import numpy as np
@@ -93,13 +94,14 @@ class FitSettings:
 
 #: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
 #: docs/fitter.md "Choosing the defaults") and the paper's method exactly (Sections
-#: 3.3-3.4): one search, its GA at 30 x 25 over all 20 betas and the 4 angles, Table 2's
-#: weights, the person -> model matching, the moments' alignment, its 512 px canvases.
+#: 3.3-3.4): one search, its GA at 30 x 25 over all 20 betas and the 4 angles, no
+#: refinement, Table 2's weights, the person -> model matching, the moments' alignment,
+#: its 512 px canvases.
 METHODS = {
     "bodyfit": FitSettings(),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False,
-                                               searches=1),
+                                               searches=1, refine_components=0),
                          canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
                          projection="orthographic",
                          render_cell_mm=0.0, placement_rounds=0),
@@ -272,20 +274,31 @@ def _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner
                               progress, replace))
     if len(results) == 1:
         return results[0]
+    place = (functools.partial(_place_cameras, model, views, masks, intrinsics, stature_m,
+                               evaluator, settings) if placing else None)
+    return _mean_of(results, evaluator, conditioner, place)
+
+
+def _mean_of(results: list[SearchResult], evaluator, conditioner, place=None) -> SearchResult:
+    """Several searches' results as one (:func:`~bodyfit.fitter.search.averaged`): the mean
+    of their genes (the first beta solved anew from the stature when ``conditioner`` is
+    given), scored by ``evaluator`` after ``place(betas, pose)`` (None: the cameras as
+    they are) has placed its cameras from that body."""
     pose = np.mean([r.pose_deg for r in results], axis=0)
     betas = np.mean([r.betas for r in results], axis=0)
     if conditioner is not None:
         betas = conditioner.complete(betas[None, 1:], pose[None])[0]
-    if placing:
-        _place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
-                       betas, pose)
+    if place is not None:
+        place(betas, pose)
     scored = evaluator.evaluate(betas[None], pose[None])
     return averaged(results, betas, pose, float(scored.costs[0]), scored.part_costs[0])
 
 
 def _refined(model, views, stature_m, first: SearchResult, settings, progress) -> SearchResult:
-    """The refinement search (``SearchSettings.refine_components``) from ``first``'s answer,
-    with the cameras ``first`` left in ``views``; joined to ``first`` by
+    """The refinement (``SearchSettings.refine_components``) of ``first``'s answer: as many
+    searches as ``first`` averaged (seeds ``seed``, ``seed + 1``, ...), each started from
+    that answer, with the cameras ``first`` left in ``views``; several averaged by
+    :func:`_mean_of` (the cameras kept); joined to ``first`` by
     :func:`~bodyfit.fitter.search.refined`."""
     s = settings.search
     refinement = s.refinement()
@@ -296,7 +309,10 @@ def _refined(model, views, stature_m, first: SearchResult, settings, progress) -
                                       stature_m, bodies)
     betas = np.r_[first.betas, np.zeros(refinement.components - len(first.betas))]
     start = np.r_[betas[len(betas) - refinement.searched_betas:], first.pose_deg]
-    return refined(first, search(evaluator, refinement, conditioner, progress, start=start))
+    results = [search(evaluator, dataclasses.replace(refinement, seed=refinement.seed + i),
+                      conditioner, progress, start=start) for i in range(refinement.searches)]
+    return refined(first, results[0] if len(results) == 1
+                   else _mean_of(results, evaluator, conditioner))
 
 
 # One BLAS thread for the whole fit: its matrices are small (CMA-ES's 24 x 24, the

@@ -47,16 +47,20 @@ def base_settings(method: str | None, config: Path | None
 
 def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSettings:
     """``base`` with every fit option of ``options`` that is not None applied: the search's
-    (``SEARCH_OPTIONS``, ``free_stature``), the cost's (``matching``, ``vertical_anchor``,
-    ``weights`` (a preset or a .toml file, replacing the weights) and ``weight`` (a list of
-    ``NAME=VALUE`` overrides on top)), ``device``, ``threads``, ``side_arms``,
-    ``projection`` and ``placement_rounds``.
+    (``SEARCH_OPTIONS``, ``free_stature``; ``components`` at or above the base's
+    ``refine_components``, that not given, turns the refinement off), the cost's
+    (``matching``, ``vertical_anchor``, ``weights`` (a preset or a .toml file, replacing
+    the weights) and ``weight`` (a list of ``NAME=VALUE`` overrides on top)), ``device``,
+    ``threads``, ``side_arms``, ``projection`` and ``placement_rounds``.
 
     Raises:
         UserError: a bad weights preset, file or override.
         ValueError: a bad matching or vertical anchor (the kernels' CostSettings check).
     """
     given = {k: v for k, v in options.items() if v is not None}
+    if ("components" in given and "refine_components" not in given
+            and given["components"] >= base.search.refine_components):
+        given["refine_components"] = 0  # the base's refinement adds no component to these
     search = dataclasses.replace(base.search, **{k: given[k] for k in SEARCH_OPTIONS
                                                  if k in given})
     if given.get("free_stature"):

@@ -27,7 +27,7 @@ from bodyfit.fitter.studio_photos import write_subject
 
 #: A tiny budget: the tests check the batch, not the fit's accuracy.
 BUDGET = ["--projection", "orthographic", "--optimizer", "cmaes", "--population", "8",
-          "--generations", "2", "--seed", "3"]
+          "--generations", "2", "--seed", "3", "--refine-components", "0"]
 GOOD = ("s0", "s1", "s2", "s3")
 #: The six-row table: four good subjects, a blank front photo, a photo that does not exist.
 SIX = ("s0", "blank", "s1", "s2", "missing", "s3")

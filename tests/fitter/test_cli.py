@@ -55,10 +55,13 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     truth = {row["letter"]: row["value_mm"] for row in truth_record["measurements"].values()}
     for key in MEASUREMENTS:
         assert truth[key] == pytest.approx(expected[key], abs=0.01)
-    # the fit went through `fitter run --camera` with its default settings, 3 generations
+    # the fit went through `fitter run --camera` with its default settings (the refinement
+    # over 40 components among them), 3 generations each
     record = json.loads((out_dir / "fit" / "run.json").read_text())
     assert record["settings"]["projection"] == "pinhole"
-    assert record["settings"]["search"]["generations"] == 3
+    search = record["settings"]["search"]
+    assert (search["generations"], search["refine_generations"]) == (3, 3)
+    assert search["refine_components"] == 40 and len(record["result"]["betas"]) == 40
     assert record["inputs"]["camera"] == "demo/camera.json"
     fitted = {row["letter"]: row["value_mm"] for row in json.loads(
         (out_dir / "fit" / "measurements.json").read_text())["measurements"].values()}

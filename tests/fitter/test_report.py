@@ -25,7 +25,8 @@ from bodyfit.kernels import CostSettings
 BETAS = np.r_[0.5, np.zeros(19)]
 POSE = np.array([5.0, 5.0, 3.0, 3.0])
 BUDGET = ["--optimizer", "ga", "--population", "10", "--generations", "2", "--seed", "5",
-          "--weight", "waist=7", "--projection", "orthographic"]  # orthographic studio photos
+          "--weight", "waist=7", "--projection", "orthographic",  # orthographic studio photos
+          "--refine-components", "0"]
 
 
 class _Page(html.parser.HTMLParser):
@@ -97,7 +98,8 @@ def test_report_is_one_self_contained_escaped_page(first_run):
 def test_run_json_round_trips_into_the_same_settings(first_run):
     config = read_run_config(first_run / "run.json")
     assert config.settings == FitSettings(
-        search=SearchSettings(optimizer="ga", population=10, generations=2, seed=5),
+        search=SearchSettings(optimizer="ga", population=10, generations=2, seed=5,
+                              refine_components=0),
         projection="orthographic",
         cost=dataclasses.replace(FitSettings().cost,
                                  part_weights=(2.0, 5.0, 7.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0)))
@@ -165,3 +167,18 @@ def test_without_config_the_person_is_required(capsys):
     assert main(["-q", "run", "--front", "f.png", "-o", "out"]) == 2
     err = capsys.readouterr().err
     assert "--side, --height-cm" in err and "--config" in err
+
+
+@pytest.mark.parametrize("options, refine", [
+    ({}, 40), ({"components": 30}, 40), ({"components": 40}, 0), ({"components": 50}, 0),
+    ({"components": 40, "refine_components": 50}, 50), ({"refine_components": 0}, 0)])
+def test_components_at_or_past_the_refinement_turn_it_off(options, refine):
+    """bodyfit's refinement over 40 components adds none to a search of 40 or more: it is
+    off unless --refine-components is given too (and then validated as given)."""
+    from bodyfit.fitter.fit import METHODS
+    from bodyfit.fitter.run_options import fit_settings
+
+    settings = fit_settings(METHODS["bodyfit"], {"components": None, **options})
+    assert settings.search.refine_components == refine
+    assert fit_settings(METHODS["paper"], options).search.refine_components == options.get(
+        "refine_components", 0)

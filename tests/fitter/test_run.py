@@ -12,7 +12,8 @@ from bodyfit.fitter.studio_photos import write_subject
 
 TRUE_BETAS = np.array([0.8, -0.6, 0.5, 0.3, -0.4] + [0.0] * 15)
 TRUE_POSE = np.array([6.0, 6.0, 3.0, 3.0])
-BUDGET = ["--optimizer", "cmaes", "--population", "24", "--generations", "30", "--seed", "1"]
+BUDGET = ["--optimizer", "cmaes", "--population", "24", "--generations", "30", "--seed", "1",
+          "--refine-components", "0"]
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +74,8 @@ def test_default_fit_measures_the_subject(subject, tmp_path, capsys):
 
 def test_same_seed_same_result(subject, tmp_path, capsys):
     folder, truth = subject
-    budget = ["--optimizer", "ga", "--population", "12", "--generations", "3", "--seed", "4"]
+    budget = ["--optimizer", "ga", "--population", "12", "--generations", "3", "--seed", "4",
+              "--refine-components", "0"]
     runs = []
     for name in ("a", "b"):
         code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
@@ -88,7 +90,7 @@ def test_two_searches_answer_with_the_mean_of_their_answers(subject, tmp_path, c
     betas 2..K of the single searches with seeds 4 and 5 (the first beta is solved anew
     from the stature), scored by the kernels at its own cost."""
     folder, truth = subject
-    budget = ["--population", "8", "--generations", "4"]
+    budget = ["--population", "8", "--generations", "4", "--refine-components", "0"]
     results = {}
     for name, options in (("4", ["--searches", "1", "--seed", "4"]),
                           ("5", ["--searches", "1", "--seed", "5"]),
@@ -113,32 +115,37 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
                                                                      capsys):
     """--refine-components 24: the searches run as without it (their curves and
     per-generation answers the same, the answers padded with zero components), then the
-    refinement's generations follow; the answer has 24 components, scored at its cost."""
+    refinements' generations follow, as many refinements as searches (one with
+    --searches 1); the answer has 24 components, scored at its cost."""
     folder, truth = subject
     budget = ["--population", "8", "--generations", "4", "--seed", "4"]
+    refine = ["--refine-components", "24", "--refine-generations", "3"]
     results = {}
-    for name, options in (("searches", []),
-                          ("refined", ["--refine-components", "24", "--refine-generations",
-                                       "3"])):
+    for name, options in (("searches", ["--refine-components", "0"]), ("refined", refine),
+                          ("one", [*refine, "--searches", "1"])):
         code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
                            str(tmp_path / name), *budget, *options)
         assert code == 0, err
         results[name] = json.loads((tmp_path / name / "run.json").read_text())["result"]
     searches, refined = results["searches"], results["refined"]
     assert len(refined["betas"]) == 24 and len(searches["betas"]) == 20
-    assert refined["evaluations"] == 2 * 8 * 4 + 8 * 3 and refined["generations"] == 7
+    assert refined["evaluations"] == 2 * 8 * 4 + 2 * 8 * 3 and refined["generations"] == 7
+    assert results["one"]["evaluations"] == 8 * 4 + 8 * 3
     assert refined["best_cost_per_generation"][:4] == searches["best_cost_per_generation"]
     answers = np.array(refined["best_betas_per_generation"])
     np.testing.assert_allclose(answers[:4, :20], searches["best_betas_per_generation"])
     assert not answers[:4, 20:].any() and answers[4:, 20:].any()
+    assert not np.allclose(refined["betas"], results["one"]["betas"])
     assert sum(refined["part_costs"].values()) == pytest.approx(refined["best_cost"],
                                                                 rel=1e-5)
-    assert "24 components, 3 generations" in (tmp_path / "refined" / "report.html").read_text()
+    assert "24 components, 3 generations, 2 averaged" in (tmp_path / "refined"
+                                                          / "report.html").read_text()
 
 
 def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     folder, truth = subject
-    budget = ["--optimizer", "ga", "--population", "8", "--generations", "1"]
+    budget = ["--optimizer", "ga", "--population", "8", "--generations", "1",
+              "--refine-components", "0"]
     costs = {}
     for name, extra in (("paper", []), ("waist", ["--weight", "waist=50"])):
         code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
@@ -179,7 +186,8 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(subject, tmp_path, caps
     args.update(change)
     argv = [item for pair in args.items() for item in pair]
     out = tmp_path / "out"
-    code, _, err = run(capsys, "run", *argv, "-o", str(out), "--generations", "1")
+    code, _, err = run(capsys, "run", *argv, "-o", str(out), "--generations", "1",
+                       "--refine-generations", "1")
     assert code == 2
     assert err.startswith("fitter: error:") and len(err.strip().splitlines()) == 1
     import re

@@ -79,7 +79,7 @@ def test_a_side_photo_with_the_arms_down_costs_the_true_body_little_only_with_ar
                           truth["O"] / 10)
     masks = person_masks(inputs)
     search = SearchSettings(optimizer="ga", population=4, generations=1,
-                            condition_stature=False)
+                            condition_stature=False, refine_components=0)
     side_cost = {}
     for arms in ("down", "hidden"):
         fit = fit_person(body_model, masks, truth["O"] / 1000,
