@@ -63,9 +63,9 @@ class SearchSettings:
             of ``REFINE_SIGMA0``, for ``refine_generations`` generations of ``population``,
             their answers averaged; the components past K carry the shape K cannot (with
             K = 20, 7.1 mm of the 7 important measurements of real bodies). One refinement
-            alone varies with its seed by about its error; two averaged gained 2.6 mm
-            out-of-space and lost nothing in-space (docs/accuracy.md, "Pushing the
-            numbers", steps 14-15). 0: none (the paper).
+            alone varies with its seed by about its error; two averaged gained 2.1 mm
+            out-of-space and lost 0.5 in-space (the first 80 subjects of each set;
+            docs/accuracy.md, "Pushing the numbers", steps 14-15). 0: none (the paper).
         refine_generations: each refinement's generations.
     """
 
