@@ -201,26 +201,50 @@ def floor(args) -> None:
               + " | ".join(f"{v:.1f}" for v in np.abs(errors).mean(axis=0)) + " |")
 
 
-def _run_spec(spec: str) -> tuple[str, Path, Path]:
-    """LABEL=SET:NAME -> (label, the set, the run's folder)."""
+def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
+    """LABEL=SET:NAME[+NAME...] -> (label, the set, the runs' folders). Several runs make
+    one (a run continued on another machine): each subject from the first run holding it."""
     label, _, where = spec.partition("=")
-    set_folder, _, name = where.rpartition(":")
-    return label, Path(set_folder), Path(set_folder) / "runs" / name
+    set_folder, _, names = where.rpartition(":")
+    return label, Path(set_folder), [Path(set_folder) / "runs" / name
+                                     for name in names.split("+")]
+
+
+def _run_scores(set_folder: Path, runs: list[Path], first: int | None) -> tuple[object, str]:
+    """The joined scores of ``runs`` (each subject from the first run holding it, fitted or
+    failed), over the set's first ``first`` subjects, and where and how fast each part went."""
+    parts, seen = [], set()
+    for run in runs:
+        scores = read_scores(set_folder, run)
+        held = set(scores.ids) | {subject for subject, _ in scores.failures}
+        parts.append((run, _first(_subset(scores, held - seen), set_folder, first)))
+        seen |= held
+    joined = dataclasses.replace(
+        parts[0][1], ids=[i for _, s in parts for i in s.ids],
+        failures=[f for _, s in parts for f in s.failures],
+        **{field: np.concatenate([getattr(s, field) for _, s in parts])
+           for field in ("errors", "spreads", "seconds", "hard")})
+    timing = "; ".join((f"{run.name}: " if len(parts) > 1 else "") + _timing(scores, run)
+                       for run, scores in parts)
+    return joined, timing
 
 
 def _timing(scores, run: Path) -> str:
-    """Where and how fast the run went, from its batch.json and bench.json."""
+    """Where and how fast the run went, from its batch.json and, when the run was started
+    by `fit`, its bench.json (the machine and the peak memory)."""
     if not (run / "batch.json").exists():  # fitter batch was stopped before its end
         return f"{len(scores.ids)} fitted; stopped before its end, no timing recorded"
-    record = json.loads((run / "bench.json").read_text())["runs"]
     batch = json.loads((run / "batch.json").read_text())
     fitted, wall = batch["subjects"]["fitted"], batch["seconds"]["total"]
-    return (f"{len(scores.ids)} fitted, {len(scores.failures)} failed; each subject's job "
+    text = (f"{len(scores.ids)} fitted, {len(scores.failures)} failed; each subject's job "
             f"(photos to written results) {np.nanmedian(scores.seconds):.1f} s median; the "
             f"last batch fitted {fitted} in {wall:.0f} s wall ({wall / max(fitted, 1):.2f} s "
             f"per subject, {batch['workers']} workers, "
-            f"`fitter batch {' '.join(record[-1]['command'][3:])}`) on "
-            f"{record[-1]['machine']}; peak memory of one process "
+            f"`fitter batch {' '.join(batch['command'][3:])}`)")
+    if not (run / "bench.json").exists():  # fitter batch run by hand
+        return text
+    record = json.loads((run / "bench.json").read_text())["runs"]
+    return (f"{text} on {record[-1]['machine']}; peak memory of one process "
             f"{max(r['peak_rss_mb'] for r in record)} MB")
 
 
@@ -228,10 +252,10 @@ def report(args) -> None:
     mains = [_run_spec(spec) for spec in args.main]
     ablations = [_run_spec(spec) for spec in args.ablation]
     table4 = {}
-    for label, set_folder, run in mains:
-        scores = _first(read_scores(set_folder, run), set_folder, args.first)
+    for label, set_folder, runs in mains:
+        scores, timing = _run_scores(set_folder, runs, args.first)
         table4[label] = scores
-        print(f"### {label}\n\n{_timing(scores, run)}.\n")
+        print(f"### {label}\n\n{timing}.\n")
         print("\n".join(measurement_table(scores)) + "\n")
         if 2 <= scores.hard.sum() <= len(scores.hard) - 2:
             hard = {i for i, h in zip(scores.ids, scores.hard) if h}
@@ -241,13 +265,13 @@ def report(args) -> None:
         if scores.failures:
             print("Failures:\n\n" + "\n".join(failure_lines(scores)) + "\n")
     baselines, first_of_set = {}, {}  # each ablation is paired with its set's first row
-    for label, set_folder, run in ablations:
+    for label, set_folder, runs in ablations:
         baseline = first_of_set.setdefault(set_folder.resolve(), label)
         if baseline != label:
             baselines[label] = baseline
-        scores = _first(read_scores(set_folder, run), set_folder, args.first)
+        scores, timing = _run_scores(set_folder, runs, args.first)
         table4[label] = scores
-        print(f"- {label}: {_timing(scores, run)}")
+        print(f"- {label}: {timing}")
     print("\n### The 7 important measurements (Table 4 form)\n")
     print("\n".join(important_table(table4, baselines)))
 

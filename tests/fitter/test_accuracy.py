@@ -5,6 +5,7 @@ working fitter."""
 import dataclasses
 import os
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -131,6 +132,15 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert mean7 < 20.0
     stature = next(line for line in report.splitlines() if line.startswith("| O stature"))
     assert float(stature.split("|")[2].split("±")[0]) < 1.0  # the stature is given
+    # a run continued elsewhere: two runs joined (A+B) report as the one run they split
+    runs = subject_set / "runs"
+    shutil.copytree(runs / "small", runs / "first-half")
+    lines = (runs / "small" / "summary.csv").read_text().splitlines(keepends=True)
+    (runs / "first-half" / "summary.csv").write_text("".join(
+        lines[:3] + [line.replace(",fitted,", ",not run,", 1) for line in lines[3:]]))
+    joined = tool("report", "--main", f"small={subject_set}:first-half+small")
+    assert joined.split("\n\n", 2)[2] == report.split("\n\n", 2)[2]  # the same tables
+    assert "first-half: 2 fitted" in joined and "small: 2 fitted" in joined
     # Fig. 12: the error after the last generation is the run's own error (round trip)
     printed = tool("figures", str(subject_set), "--curve", "small=small", "--meshes", "small",
                    "--generations", "80", "--docs", str(tmp_path))
