@@ -50,7 +50,7 @@ from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, error_p
                                              fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean_of_important,
                                             measurement_table)
-from bodyfit.fitter.accuracy.scores import KEYS, read_scores
+from bodyfit.fitter.accuracy.scores import KEYS, RunScores, read_scores
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
                                                  read_settings, read_truth, subject_ids,
                                                  write_bodies, write_photos_of_set)
@@ -210,7 +210,7 @@ def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
                                      for name in names.split("+")]
 
 
-def _run_scores(set_folder: Path, runs: list[Path], first: int | None) -> tuple[object, str]:
+def _run_scores(set_folder: Path, runs: list[Path], first: int | None) -> tuple[RunScores, str]:
     """The joined scores of ``runs`` (each subject from the first run holding it, fitted or
     failed), over the set's first ``first`` subjects, and where and how fast each part went."""
     parts, seen = [], set()
