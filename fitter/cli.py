@@ -107,11 +107,14 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "are averaged (default 2; --method paper: 1)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
-                             "first K components, as many refinements as searches, averaged "
-                             "(more than --components; default 40, none when --components "
-                             "is 40 or more; 0: none; --method paper: 0)")
+                             "first K components, --refinements of them, averaged (more "
+                             "than --components; default 40, none when --components is 40 "
+                             "or more; 0: none; --method paper: 0)")
     parser.add_argument("--refine-generations", type=int,
                         help="each refinement's generations (default 250)")
+    parser.add_argument("--refinements", type=int,
+                        help="refinements (seeds SEED, SEED+1, ...) whose answers are averaged "
+                             "(default 4)")
     parser.add_argument("--free-stature", action="store_true", default=None,
                         help="search the first shape component like the others (the paper) "
                              "instead of solving it so every candidate stands as tall as the "

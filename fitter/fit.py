@@ -295,9 +295,9 @@ def _mean_of(results: list[SearchResult], evaluator, conditioner, place=None) ->
 
 
 def _refined(model, views, stature_m, first: SearchResult, settings, progress) -> SearchResult:
-    """The refinement (``SearchSettings.refine_components``) of ``first``'s answer: as many
-    searches as ``first`` averaged (seeds ``seed``, ``seed + 1``, ...), each started from
-    that answer, with the cameras ``first`` left in ``views``; several averaged by
+    """The refinement (``SearchSettings.refine_components``) of ``first``'s answer:
+    ``refinements`` searches (seeds ``seed``, ``seed + 1``, ...), each started from that
+    answer, with the cameras ``first`` left in ``views``; several averaged by
     :func:`_mean_of` (the cameras kept); joined to ``first`` by
     :func:`~bodyfit.fitter.search.refined`."""
     s = settings.search

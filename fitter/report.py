@@ -88,8 +88,8 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
         ("components", _e(search["components"])),
         ("refinement", f"{_e(search['refine_components'])} components, "
                        f"{_e(search['refine_generations'])} generations"
-                       + (f", {_e(search['searches'])} averaged" if search["searches"] > 1
-                          else "")
+                       + (f", {_e(search['refinements'])} averaged"
+                          if search.get("refinements", 1) > 1 else "")
          if search.get("refine_components") else "none"),
         ("matching", _e(cost["matching"])),
         ("seed", _e(search["seed"])),

@@ -25,7 +25,7 @@ __all__ = ["INPUT_OPTIONS", "SEARCH_OPTIONS", "base_settings", "fit_settings"]
 INPUT_OPTIONS = ("front", "side", "height_cm", "camera", "mask_front", "mask_side",
                  "background_front", "background_side", "sex")
 SEARCH_OPTIONS = ("optimizer", "population", "generations", "components", "seed",
-                  "searches", "refine_components", "refine_generations")
+                  "searches", "refine_components", "refine_generations", "refinements")
 
 
 def base_settings(method: str | None, config: Path | None

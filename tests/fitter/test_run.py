@@ -115,22 +115,22 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
                                                                      capsys):
     """--refine-components 24: the searches run as without it (their curves and
     per-generation answers the same, the answers padded with zero components), then the
-    refinements' generations follow, as many refinements as searches (one with
-    --searches 1); the answer has 24 components, scored at its cost."""
+    refinements' generations follow, four refinements by default (one with
+    --refinements 1); the answer has 24 components, scored at its cost."""
     folder, truth = subject
     budget = ["--population", "8", "--generations", "4", "--seed", "4"]
     refine = ["--refine-components", "24", "--refine-generations", "3"]
     results = {}
     for name, options in (("searches", ["--refine-components", "0"]), ("refined", refine),
-                          ("one", [*refine, "--searches", "1"])):
+                          ("one", [*refine, "--refinements", "1"])):
         code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",
                            str(tmp_path / name), *budget, *options)
         assert code == 0, err
         results[name] = json.loads((tmp_path / name / "run.json").read_text())["result"]
     searches, refined = results["searches"], results["refined"]
     assert len(refined["betas"]) == 24 and len(searches["betas"]) == 20
-    assert refined["evaluations"] == 2 * 8 * 4 + 2 * 8 * 3 and refined["generations"] == 7
-    assert results["one"]["evaluations"] == 8 * 4 + 8 * 3
+    assert refined["evaluations"] == 2 * 8 * 4 + 4 * 8 * 3 and refined["generations"] == 7
+    assert results["one"]["evaluations"] == 2 * 8 * 4 + 8 * 3
     assert refined["best_cost_per_generation"][:4] == searches["best_cost_per_generation"]
     answers = np.array(refined["best_betas_per_generation"])
     np.testing.assert_allclose(answers[:4, :20], searches["best_betas_per_generation"])
@@ -138,7 +138,7 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
     assert not np.allclose(refined["betas"], results["one"]["betas"])
     assert sum(refined["part_costs"].values()) == pytest.approx(refined["best_cost"],
                                                                 rel=1e-5)
-    assert "24 components, 3 generations, 2 averaged" in (tmp_path / "refined"
+    assert "24 components, 3 generations, 4 averaged" in (tmp_path / "refined"
                                                           / "report.html").read_text()
 
 
@@ -167,6 +167,7 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--optimizer": "sgd"}, "invalid choice"),
     ({"--components": "99"}, "components"),
     ({"--refine-components": "20"}, "refine-components must be 0 or 21-"),
+    ({"--refinements": "0"}, "--refinements must be at least 1"),
     ({"--matching": "both"}, "matching"),
     ({"--side-arms": "up"}, "invalid choice"),
     ({"--threads": "0"}, "--threads"),
