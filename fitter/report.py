@@ -89,7 +89,7 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
         ("refinement", f"{_e(search['refine_components'])} components, "
                        f"{_e(search['refine_generations'])} generations"
                        + (f", {_e(search['refinements'])} averaged"
-                          if search.get("refinements", 1) > 1 else "")
+                          if search["refinements"] > 1 else "")
          if search.get("refine_components") else "none"),
         ("matching", _e(cost["matching"])),
         ("seed", _e(search["seed"])),

@@ -25,7 +25,8 @@ __all__ = ["SearchSettings", "SearchResult", "search", "averaged", "refined", "R
 #: The refinement's initial step (``SearchSettings.refine_components``), a fraction of every
 #: gene's range: 0.5 sd of a beta, 3 degrees of an angle (on the first 20 out-of-space
 #: subjects, 0.05 for 100 generations gained 0.2 mm, 0.08 for 250 gained 2.0:
-#: docs/accuracy.md, step 14). Not tuned further.
+#: docs/accuracy.md, step 14; two refinements at 0.04 against 0.08 on the first 40 of each
+#: set: -0.42 mm in-space, +0.15 out-of-space, step 16).
 REFINE_SIGMA0 = 0.08
 
 
@@ -61,12 +62,12 @@ class SearchSettings:
             (CMA-ES's, seeds ``seed``, ``seed + 1``, ...) over the first K' components and
             the angles, each started from the searches' answer (the components past K at
             0) with a step of ``REFINE_SIGMA0``, for ``refine_generations`` generations of
-            ``population``, their answers averaged; the components past K carry the shape K cannot (with
-            K = 20, 7.1 mm of the 7 important measurements of real bodies). One refinement
-            alone varies with its seed by about its error; two averaged gained 2.0 mm
-            out-of-space and lost 0.6 in-space (200 subjects of each set), four gained
-            0.4 mm more in each set (the first 40; docs/accuracy.md, "Pushing the
-            numbers", steps 14-16). 0: none (the paper).
+            ``population``, their answers averaged; the components past K carry the shape K
+            cannot (with K = 20, 7.1 mm of the 7 important measurements of real bodies).
+            One refinement alone varies with its seed by about its error; two averaged
+            gained 2.0 mm out-of-space and lost 0.6 in-space (200 subjects of each set),
+            four gained 0.4 mm more in each set (the first 40; docs/accuracy.md, "Pushing
+            the numbers", steps 14-16). 0: none (the paper).
         refine_generations: each refinement's generations.
         refinements: how many refinements are averaged. Their answers scatter about the
             body the silhouettes fix, each by about its error (the cost is flat across
