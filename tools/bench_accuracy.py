@@ -11,6 +11,13 @@
     # Markdown tables (docs/accuracy.md holds them)
     python tools/bench_accuracy.py report --main "in-space=SETS/in:default" \
         --ablation "uniform weights=SETS/in:uniform-weights"
+    # a run's tables kept for the repository (docs/accuracy-runs/in-space/default/), then
+    # continued in a later session from the set made anew: rows 100-199 in a second run,
+    # the two joined by the report
+    python tools/bench_accuracy.py keep SETS/in default
+    python tools/bench_accuracy.py fit SETS/in default-b --first 200 --skip 100
+    python tools/bench_accuracy.py report \
+        --main "in-space=SETS/in:docs/accuracy-runs/in-space/default+default-b"
     # how far calib's extracted outlines lie from the exact silhouettes, per refinement passes
     python tools/bench_accuracy.py outlines SETS/in --first 10 --passes 1 2 4
     # the space's floor: the error of each true body's closest body of K components
@@ -23,6 +30,11 @@
 out-of-space draw needs Anny, the photos do not), ``make`` again photographs them; a set
 or a run interrupted is continued by the same command. A run lies in SET/runs/NAME/
 (fitter batch's output) with bench.json: its command, wall time, peak memory, machine.
+``keep`` copies what ``report`` reads of a run (summary.csv, failures.csv, batch.json,
+bench.json; the set's set.json; its fitted subjects' truths as truths.json) to
+docs/accuracy-runs/<kind>/NAME/, to be committed: a run's per-subject folders are not
+kept, a set is remade from its seed, so a run kept in one session is reported, and
+continued (``fit --skip``), in the next.
 """
 
 from __future__ import annotations
@@ -35,6 +47,7 @@ import multiprocessing
 import os
 import platform
 import resource
+import shutil
 import subprocess
 import sys
 import time
@@ -50,7 +63,10 @@ from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, error_p
                                              fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean_of_important,
                                             measurement_table)
-from bodyfit.fitter.accuracy.scores import KEYS, RunScores, read_scores
+from bodyfit.fitter.accuracy.scores import (KEYS, TRUTHS_FILE, RunScores, read_scores,
+                                            truth_records)
+from bodyfit.fitter.batch.orchestration import BATCH_FILE
+from bodyfit.fitter.batch.tables import FAILURES_FILE, SUMMARY_FILE
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
                                                  read_settings, read_truth, subject_ids,
                                                  write_bodies, write_photos_of_set)
@@ -96,10 +112,11 @@ def _command(name: str) -> str:
     return str(beside) if beside.exists() else name
 
 
-def _table_rows(folder: Path, first: int, keepends: bool = False) -> list[str]:
-    """subjects.csv's header and its first ``first`` rows: as many women as men
-    (subject_set's order)."""
-    return (folder / "subjects.csv").read_text().splitlines(keepends)[:first + 1]
+def _table_rows(folder: Path, first: int, keepends: bool = False, skip: int = 0) -> list[str]:
+    """subjects.csv's header and its first ``first`` rows but the first ``skip``: as many
+    women as men when both are even (subject_set's order)."""
+    lines = (folder / "subjects.csv").read_text().splitlines(keepends)
+    return lines[:1] + lines[1 + skip:first + 1]
 
 
 def fit(args, batch_options: list[str]) -> None:
@@ -114,9 +131,12 @@ def fit(args, batch_options: list[str]) -> None:
                        stdout=subprocess.DEVNULL)
     out = folder / "runs" / args.name
     table = folder / "subjects.csv"
+    if args.skip and not args.first:
+        sys.exit("--skip needs --first (the rows --skip to --first - 1 are fitted)")
     if args.first:
-        table = folder / f"subjects-first{args.first}.csv"
-        table.write_text("".join(_table_rows(folder, args.first, keepends=True)))
+        table = folder / (f"subjects-rows{args.skip}-{args.first - 1}.csv" if args.skip
+                          else f"subjects-first{args.first}.csv")
+        table.write_text("".join(_table_rows(folder, args.first, True, args.skip)))
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
                *(["--camera", str(camera)] if args.camera == "calibrated" else []),
                *batch_options]
@@ -201,12 +221,33 @@ def floor(args) -> None:
               + " | ".join(f"{v:.1f}" for v in np.abs(errors).mean(axis=0)) + " |")
 
 
+def keep(args) -> None:
+    """Copy a run's tables (what `report` reads) out of the set, to be committed: a set is
+    remade by `make` from its seed, a run's per-subject folders are not kept."""
+    run = Path(args.set) / "runs" / args.name
+    if not (run / SUMMARY_FILE).exists():
+        sys.exit(f"{run}: no {SUMMARY_FILE} (not a run of fitter batch)")
+    kind = read_settings(Path(args.set)).kind
+    kept = Path(args.to) / kind / args.name
+    kept.mkdir(parents=True, exist_ok=True)
+    for name in (SUMMARY_FILE, FAILURES_FILE, BATCH_FILE, "bench.json", "set.json"):
+        source = (Path(args.set) if name == "set.json" else run) / name
+        if source.exists():
+            shutil.copyfile(source, kept / name)
+    fitted = read_scores(Path(args.set), run).ids
+    (kept / TRUTHS_FILE).write_text(json.dumps(truth_records(Path(args.set), fitted), indent=1))
+    print(f"{run} -> {kept}: {len(fitted)} fitted")
+
+
 def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
-    """LABEL=SET:NAME[+NAME...] -> (label, the set, the runs' folders). Several runs make
-    one (a run continued on another machine): each subject from the first run holding it."""
+    """LABEL=SET:RUN[+RUN...] -> (label, the set, the runs' folders); a RUN is a name
+    (SET/runs/RUN) or a folder of `keep` (a path holding a "/"). Several runs make one (a
+    run continued on another machine or in another session): each subject from the first
+    run holding it."""
     label, _, where = spec.partition("=")
     set_folder, _, names = where.rpartition(":")
-    return label, Path(set_folder), [Path(set_folder) / "runs" / name
+    return label, Path(set_folder), [Path(name) if "/" in name
+                                     else Path(set_folder) / "runs" / name
                                      for name in names.split("+")]
 
 
@@ -357,10 +398,19 @@ def main() -> None:
                    help="none: fitter batch without --camera (a typical phone assumed)")
     p.add_argument("--first", type=int, help="fit only the set's first N subjects (N even: "
                    "half women, half men)")
+    p.add_argument("--skip", type=int, default=0, metavar="I",
+                   help="with --first N: leave out the first I subjects (fitted by another "
+                   "run, e.g. in an earlier session), fit rows I to N - 1")
+    p = sub.add_parser("keep", help="copy a run's tables out of its set, to commit them")
+    p.add_argument("set")
+    p.add_argument("name", help="the run's name (SET/runs/NAME)")
+    p.add_argument("--to", default="docs/accuracy-runs",
+                   help="folder of kept runs: TO/<set kind>/NAME/ (default: %(default)s)")
     p = sub.add_parser("report", help="Markdown tables of runs")
-    p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:NAME",
-                   help="a run with its full Table 3 form")
-    p.add_argument("--ablation", action="append", default=[], metavar="LABEL=SET:NAME",
+    p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
+                   help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "
+                   "kept run's folder; RUN+RUN+...: runs joined)")
+    p.add_argument("--ablation", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run in the Table 4 form only")
     p.add_argument("--first", type=int, help="every row over its set's first N subjects "
                    "only (compare runs of `fit --first N` with a full run)")
@@ -388,7 +438,7 @@ def main() -> None:
     if args.command == "fit":
         fit(args, batch_options)
     else:
-        {"make": make, "report": report, "outlines": outlines, "floor": floor,
+        {"make": make, "keep": keep, "report": report, "outlines": outlines, "floor": floor,
          "figures": figures}[args.command](args)
 
 

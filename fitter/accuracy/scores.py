@@ -3,6 +3,9 @@
 A run is ``fitter batch``'s output folder for a subject set (:mod:`.subject_set`): its
 summary.csv holds each fitted subject's 16 measurements and spreads, failures.csv each
 failed subject's reason. Errors are estimate - truth, millimetres, ``MEASUREMENTS`` order.
+The truths are the set's truth.json files, or a run folder's own truths.json (``{id:
+record}``, written by ``tools/bench_accuracy.py keep``) when it has one: a kept run is
+reported against the truths it was fitted to, whatever machine remade the set.
 """
 
 from __future__ import annotations
@@ -18,11 +21,13 @@ from scipy import stats
 from bodyfit.fitter.batch.tables import FAILURES_FILE, SUMMARY_FILE
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 
-__all__ = ["RunScores", "ErrorStats", "read_scores", "error_stats", "KEYS", "IMPORTANT_COLUMNS"]
+__all__ = ["RunScores", "ErrorStats", "read_scores", "truth_records", "error_stats", "KEYS",
+           "IMPORTANT_COLUMNS", "TRUTHS_FILE"]
 
 KEYS = list(MEASUREMENTS)
 IMPORTANT_COLUMNS = [KEYS.index(key) for key in IMPORTANT]
 _FITTED = ("fitted", "fitted earlier")
+TRUTHS_FILE = "truths.json"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -46,17 +51,26 @@ class RunScores:
     hard: np.ndarray
 
 
+def truth_records(set_folder: Path, ids: list[str]) -> dict[str, dict]:
+    """id -> that subject's truth.json record in the set ``set_folder``."""
+    return {i: json.loads((Path(set_folder) / i / "truth.json").read_text()) for i in ids}
+
+
 def read_scores(set_folder: Path, run_folder: Path) -> RunScores:
-    """The scores of the run in ``run_folder`` on the subject set in ``set_folder``."""
+    """The scores of the run in ``run_folder`` on the subject set in ``set_folder`` (the
+    truths from the run's truths.json instead, when it has one)."""
     set_folder, run_folder = Path(set_folder), Path(run_folder)
     with open(run_folder / SUMMARY_FILE, newline="", encoding="utf-8") as file:
         rows = [row for row in csv.DictReader(file) if row["status"] in _FITTED]
     with open(run_folder / FAILURES_FILE, newline="", encoding="utf-8") as file:
         failures = [(row["id"], row["reason"]) for row in csv.DictReader(file)]
+    kept = run_folder / TRUTHS_FILE
+    records = (json.loads(kept.read_text()) if kept.exists()
+               else truth_records(set_folder, [row["id"] for row in rows]))
     names = [name for name, _ in MEASUREMENTS.values()]
     errors, spreads, seconds, hard = [], [], [], []
     for row in rows:
-        record = json.loads((set_folder / row["id"] / "truth.json").read_text())
+        record = records[row["id"]]
         truth = record["measurements"]
         errors.append([float(row[f"{name}_mm"]) - truth[key] for key, name in zip(KEYS, names)])
         spreads.append([float(row[f"{name}_spread_mm"] or "nan") for name in names])

@@ -132,15 +132,25 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert mean7 < 20.0
     stature = next(line for line in report.splitlines() if line.startswith("| O stature"))
     assert float(stature.split("|")[2].split("±")[0]) < 1.0  # the stature is given
-    # a run continued elsewhere: two runs joined (A+B) report as the one run they split
-    runs = subject_set / "runs"
-    shutil.copytree(runs / "small", runs / "first-half")
-    lines = (runs / "small" / "summary.csv").read_text().splitlines(keepends=True)
-    (runs / "first-half" / "summary.csv").write_text("".join(
+    # a run continued elsewhere: its kept tables (`keep`) and a run of the rest, joined
+    # (A+B), report as the one run they split
+    tool("keep", str(subject_set), "small", "--to", str(tmp_path / "kept"))
+    kept = tmp_path / "kept" / "in-space"
+    assert {p.name for p in (kept / "small").iterdir()} == {
+        "summary.csv", "failures.csv", "batch.json", "bench.json", "set.json", "truths.json"}
+    shutil.copytree(kept / "small", kept / "first-half")
+    lines = (kept / "small" / "summary.csv").read_text().splitlines(keepends=True)
+    (kept / "first-half" / "summary.csv").write_text("".join(
         lines[:3] + [line.replace(",fitted,", ",not run,", 1) for line in lines[3:]]))
-    joined = tool("report", "--main", f"small={subject_set}:first-half+small")
+    joined = tool("report", "--main", f"small={subject_set}:{kept / 'first-half'}+small")
     assert joined.split("\n\n", 2)[2] == report.split("\n\n", 2)[2]  # the same tables
     assert "first-half: 2 fitted" in joined and "small: 2 fitted" in joined
+    # a kept run carries its truths: reported without the set's truth files
+    first = next(subject_set.glob("s0000-*")) / "truth.json"
+    first.rename(first.with_suffix(".moved"))
+    alone = tool("report", "--main", f"small={subject_set}:{kept / 'small'}")
+    first.with_suffix(".moved").rename(first)
+    assert alone.split("\n\n", 2)[2] == report.split("\n\n", 2)[2]
     # Fig. 12: the error after the last generation is the run's own error (round trip)
     printed = tool("figures", str(subject_set), "--curve", "small=small", "--meshes", "small",
                    "--generations", "80", "--docs", str(tmp_path))
@@ -159,6 +169,11 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     printed = tool("floor", str(subject_set), "--first", "4", "--components", "5", "20")
     floor = {int(m[1]): float(m[2]) for m in re.finditer(r"\| (\d+) \| ([.\d]+) \(", printed)}
     assert floor[20] < 0.05 and floor[5] > 1.0
+    # the rest of a set: rows 2-3 only (all fitted already in this run: it resumes, fits none)
+    tool("fit", str(subject_set), "small", "--first", "4", "--skip", "2")
+    rows = (subject_set / "subjects-rows2-3.csv").read_text().splitlines()
+    assert rows[0] == (subject_set / "subjects.csv").read_text().splitlines()[0]
+    assert [row.split(",")[0] for row in rows[1:]] == [line.split(",")[0] for line in lines[3:]]
 
 
 def test_failures_are_counted_by_reason():
