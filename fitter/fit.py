@@ -24,7 +24,8 @@ from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, 
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
-from bodyfit.fitter.search import SearchResult, SearchSettings, averaged, refined, search
+from bodyfit.fitter.search import (SearchResult, SearchSettings, averaged, refined, search,
+                                   searches_together)
 from bodyfit.fitter.side_arms import side_view_options
 from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
 from bodyfit.fitter.weights import cost_settings
@@ -297,7 +298,8 @@ def _mean_of(results: list[SearchResult], evaluator, conditioner, place=None) ->
 def _refined(model, views, stature_m, first: SearchResult, settings, progress) -> SearchResult:
     """The refinement (``SearchSettings.refine_components``) of ``first``'s answer:
     ``refinements`` searches (seeds ``seed``, ``seed + 1``, ...), each started from that
-    answer, with the cameras ``first`` left in ``views``; several averaged by
+    answer, with the cameras ``first`` left in ``views``, side by side
+    (:func:`~bodyfit.fitter.search.searches_together`); several averaged by
     :func:`_mean_of` (the cameras kept); joined to ``first`` by
     :func:`~bodyfit.fitter.search.refined`."""
     s = settings.search
@@ -309,8 +311,9 @@ def _refined(model, views, stature_m, first: SearchResult, settings, progress) -
                                       stature_m, bodies)
     betas = np.r_[first.betas, np.zeros(refinement.components - len(first.betas))]
     start = np.r_[betas[len(betas) - refinement.searched_betas:], first.pose_deg]
-    results = [search(evaluator, dataclasses.replace(refinement, seed=refinement.seed + i),
-                      conditioner, progress, start=start) for i in range(refinement.searches)]
+    seeds = [dataclasses.replace(refinement, seed=refinement.seed + i)
+             for i in range(refinement.searches)]
+    results = searches_together(evaluator, seeds, conditioner, progress, start=start)
     return refined(first, results[0] if len(results) == 1
                    else _mean_of(results, evaluator, conditioner))
 

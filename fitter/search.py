@@ -20,7 +20,8 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import POSE_NAMES
 from bodyfit.fitter.optimizers import OPTIMIZER_NAMES, make_optimizer
 
-__all__ = ["SearchSettings", "SearchResult", "search", "averaged", "refined", "REFINE_SIGMA0"]
+__all__ = ["SearchSettings", "SearchResult", "search", "searches_together", "averaged", "refined",
+           "REFINE_SIGMA0"]
 
 #: The refinement's initial step (``SearchSettings.refine_components``), a fraction of every
 #: gene's range: 0.5 sd of a beta, 3 degrees of an angle (on the first 20 out-of-space
@@ -176,6 +177,87 @@ class SearchResult:
     stop_reasons: dict
 
 
+class _Search:
+    """One search between generations: its optimiser and its per-generation records
+    (:func:`search` runs one, :func:`searches_together` several in one population)."""
+
+    def __init__(self, settings: SearchSettings, conditioner, start: np.ndarray | None):
+        if settings.condition_stature and conditioner is None:
+            raise ValueError("condition_stature needs a StatureConditioner")
+        options = {} if settings.generations is None else {"generations": settings.generations}
+        if settings.optimizer == "cmaes":
+            options["sigma0"] = settings.sigma0
+            if start is not None:
+                options["x0"] = tuple(np.clip(start, settings.lower, settings.upper))
+        elif start is not None:
+            raise ValueError("only CMA-ES starts from given genes")
+        self.settings, self.conditioner = settings, conditioner
+        self.k = settings.searched_betas
+        self.optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
+                                        population=settings.population, seed=settings.seed,
+                                        **options)
+        self.best_costs, self.mean_costs, self.answers = [], [], []
+        self.running = (np.inf, None)  # the best cost and genes scored so far
+
+    def betas_of(self, genes: np.ndarray) -> np.ndarray:
+        """(P, K) betas of (P, genes) candidates."""
+        if not self.settings.condition_stature:
+            return genes[:, :self.k]
+        return self.conditioner.complete(genes[:, :self.k], genes[:, self.k:])
+
+    def ask(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The next population: its genes (P, searched betas + 4), betas (P, K) and pose
+        (P, 4), degrees."""
+        genes = self.optimizer.ask()
+        return genes, self.betas_of(genes), genes[:, self.k:]
+
+    def tell(self, genes: np.ndarray, costs: np.ndarray) -> None:
+        """Take back the asked ``genes`` with their (P,) costs; record the generation."""
+        costs = np.asarray(costs, np.float64)
+        self.optimizer.tell(genes, costs)
+        finite = costs[np.isfinite(costs)]
+        if finite.size and finite.min() < self.running[0]:
+            self.running = (finite.min(), genes[np.flatnonzero(costs == finite.min())[0]])
+        centre = self.optimizer.centre  # the answer had the search stopped here
+        self.answers.append(centre if centre is not None else
+                            genes[0] if self.running[1] is None else self.running[1])
+        self.best_costs.append(self.optimizer.best_cost)
+        self.mean_costs.append(float(finite.mean()) if finite.size else np.inf)
+
+    def forget_best(self) -> None:
+        """The costs from now on are not comparable with the earlier ones."""
+        self.optimizer.forget_best()
+        self.running = (np.inf, None)
+
+    def result(self, evaluator, seconds: float) -> SearchResult:
+        """The search's :class:`SearchResult`, its answer scored by ``evaluator``."""
+        result, k = self.optimizer.result, self.k
+        if not np.isfinite(result.best_cost):
+            raise UserError("no candidate body produced a silhouette; check the photos and "
+                            "masks")
+        # the centre, unless it draws no silhouette; the best candidate ever scored did
+        for answer in (c for c in (result.centre, result.best_candidate) if c is not None):
+            answer_betas = self.betas_of(answer[None])
+            scored = evaluator.evaluate(answer_betas, answer[None, k:])  # cost and terms
+            if np.isfinite(scored.costs[0]):
+                break
+        return SearchResult(
+            betas=answer_betas[0], pose_deg=answer[k:], cost=float(scored.costs[0]),
+            part_costs=scored.part_costs[0], best_costs=np.array(self.best_costs),
+            best_betas=self.betas_of(np.array(self.answers)),
+            mean_costs=np.array(self.mean_costs),
+            final_genes=np.concatenate([self.betas_of(result.population),
+                                        result.population[:, k:]], axis=1),
+            final_costs=result.population_costs, evaluations=result.evaluations,
+            generations=result.generations, seconds=seconds,
+            stop_reasons=result.stop_reasons)
+
+
+def _progress_bar(description: str, progress: bool | None) -> tqdm:
+    return tqdm(desc=description, unit="gen", dynamic_ncols=True,
+                disable=None if progress is None else not progress)
+
+
 def search(evaluator, settings: SearchSettings, conditioner=None,
            progress: bool | None = None, on_generation=None,
            start: np.ndarray | None = None) -> SearchResult:
@@ -196,66 +278,45 @@ def search(evaluator, settings: SearchSettings, conditioner=None,
         start: None, or (searched betas + 4,) genes CMA-ES's distribution starts from
             (clipped to the bounds); None: the middle of the bounds (the mean body).
     """
-    k = settings.searched_betas
-    if settings.condition_stature and conditioner is None:
-        raise ValueError("condition_stature needs a StatureConditioner")
-
-    def betas_of(genes: np.ndarray) -> np.ndarray:
-        if not settings.condition_stature:
-            return genes[:, :k]
-        return conditioner.complete(genes[:, :k], genes[:, k:])
-
-    options = {} if settings.generations is None else {"generations": settings.generations}
-    if settings.optimizer == "cmaes":
-        options["sigma0"] = settings.sigma0
-        if start is not None:
-            options["x0"] = tuple(np.clip(start, settings.lower, settings.upper))
-    elif start is not None:
-        raise ValueError("only CMA-ES starts from given genes")
-    optimizer = make_optimizer(settings.optimizer, settings.lower, settings.upper,
-                               population=settings.population, seed=settings.seed, **options)
+    run = _Search(settings, conditioner, start)
     began = time.perf_counter()
-    best_costs, mean_costs, answers = [], [], []
-    running = (np.inf, None)  # the best cost and genes scored so far
-    with tqdm(desc=f"search ({settings.optimizer})", unit="gen", dynamic_ncols=True,
-              disable=None if progress is None else not progress) as bar:
-        while not optimizer.stop():
-            genes = optimizer.ask()
-            costs = evaluator.evaluate(betas_of(genes), genes[:, k:]).costs.astype(np.float64)
-            optimizer.tell(genes, costs)
-            finite = costs[np.isfinite(costs)]
-            if finite.size and finite.min() < running[0]:
-                running = (finite.min(), genes[np.flatnonzero(costs == finite.min())[0]])
-            centre = optimizer.centre  # the answer had the search stopped here
-            answers.append(centre if centre is not None else
-                           genes[0] if running[1] is None else running[1])
-            best_costs.append(optimizer.best_cost)
-            mean_costs.append(float(finite.mean()) if finite.size else np.inf)
+    with _progress_bar(f"search ({settings.optimizer})", progress) as bar:
+        while not run.optimizer.stop():
+            genes, betas, pose = run.ask()
+            run.tell(genes, evaluator.evaluate(betas, pose).costs)
             bar.update(1)
-            bar.set_postfix(best=f"{best_costs[-1]:.1f}")
-            if on_generation is not None and running[1] is not None and on_generation(
-                    len(best_costs), betas_of(running[1][None])[0], running[1][k:]):
-                optimizer.forget_best()
-                running = (np.inf, None)
-    result = optimizer.result
-    if not np.isfinite(result.best_cost):
-        raise UserError("no candidate body produced a silhouette; check the photos and masks")
-    # the centre, unless it draws no silhouette; the best candidate ever scored did
-    for answer in (c for c in (result.centre, result.best_candidate) if c is not None):
-        answer_betas = betas_of(answer[None])
-        scored = evaluator.evaluate(answer_betas, answer[None, k:])  # cost and terms
-        if np.isfinite(scored.costs[0]):
-            break
-    return SearchResult(
-        betas=answer_betas[0], pose_deg=answer[k:], cost=float(scored.costs[0]),
-        part_costs=scored.part_costs[0], best_costs=np.array(best_costs),
-        best_betas=betas_of(np.array(answers)),
-        mean_costs=np.array(mean_costs),
-        final_genes=np.concatenate([betas_of(result.population), result.population[:, k:]],
-                                   axis=1),
-        final_costs=result.population_costs, evaluations=result.evaluations,
-        generations=result.generations, seconds=time.perf_counter() - began,
-        stop_reasons=result.stop_reasons)
+            bar.set_postfix(best=f"{run.best_costs[-1]:.1f}")
+            best = run.running[1]
+            if on_generation is not None and best is not None and on_generation(
+                    len(run.best_costs), run.betas_of(best[None])[0], best[run.k:]):
+                run.forget_best()
+    return run.result(evaluator, time.perf_counter() - began)
+
+
+def searches_together(evaluator, settings: list[SearchSettings], conditioner=None,
+                      progress: bool | None = None,
+                      start: np.ndarray | None = None) -> list[SearchResult]:
+    """Several searches (one per ``settings``, e.g. other seeds) run side by side: each
+    generation, their populations are scored in one call of the evaluator, so a GPU gets
+    one launch of S x P candidates instead of S of P. Every candidate is scored on its
+    own, so each result equals :func:`search`'s with the same arguments (its ``seconds``:
+    the wall time divided among the searches). Arguments as :func:`search`'s, without
+    ``on_generation`` (the searches share the evaluator's cameras)."""
+    runs = [_Search(s, conditioner, start) for s in settings]
+    began = time.perf_counter()
+    names = ", ".join(sorted({s.optimizer for s in settings}))
+    with _progress_bar(f"{len(runs)} searches ({names})", progress) as bar:
+        while active := [run for run in runs if not run.optimizer.stop()]:
+            asked = [run.ask() for run in active]
+            costs = evaluator.evaluate(np.concatenate([betas for _, betas, _ in asked]),
+                                       np.concatenate([pose for _, _, pose in asked])).costs
+            ends = np.cumsum([len(genes) for genes, _, _ in asked])
+            for run, (genes, _, _), part in zip(active, asked, np.split(costs, ends[:-1])):
+                run.tell(genes, part)
+            bar.update(1)
+            bar.set_postfix(best=f"{min(run.best_costs[-1] for run in runs):.1f}")
+    seconds = (time.perf_counter() - began) / len(runs)
+    return [run.result(evaluator, seconds) for run in runs]
 
 
 def _padded(curves: list[np.ndarray]) -> np.ndarray:

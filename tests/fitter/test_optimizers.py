@@ -499,3 +499,36 @@ def test_search_starts_cmaes_from_the_given_genes():
     with pytest.raises(ValueError, match="only CMA-ES"):
         search(Evaluator(), dataclasses.replace(settings, optimizer="ga"), progress=False,
                start=start)
+
+
+def test_searches_together_score_one_population_and_equal_searches_alone():
+    """Three CMA-ES searches (one stopping earlier) side by side: each generation one call
+    of the evaluator with every running search's population, and each result equal to
+    its search run alone."""
+    from types import SimpleNamespace
+
+    from bodyfit.fitter.search import SearchSettings, search, searches_together
+
+    target = np.array([0.5, -1.0, 0.8])
+    sizes = []
+
+    class Evaluator:  # a rugged cost, each candidate's its own (no shared noise stream)
+        def evaluate(self, betas, pose_deg):
+            sizes.append(len(betas))
+            costs = (np.sum((betas - target) ** 2, axis=1) + 0.05 * np.sin(40 * betas[:, 0])
+                     + 0.01 * np.sum(pose_deg ** 2, axis=1))
+            return SimpleNamespace(costs=costs, part_costs=np.tile(costs[:, None], (1, 11)))
+
+    base = SearchSettings(population=8, generations=12, components=3, condition_stature=False)
+    settings = [dataclasses.replace(base, seed=0), dataclasses.replace(base, seed=1),
+                dataclasses.replace(base, seed=2, generations=5)]
+    start = np.array([0.2, 0.1, -0.3, 5.0, 5.0, 5.0, 5.0])
+    together = searches_together(Evaluator(), settings, progress=False, start=start)
+    assert sizes == [24] * 5 + [16] * 7 + [1] * 3  # then each answer scored alone
+    for alone_settings, joint in zip(settings, together):
+        alone = search(Evaluator(), alone_settings, progress=False, start=start)
+        for field in ("betas", "pose_deg", "best_costs", "mean_costs", "best_betas",
+                      "final_genes", "final_costs"):
+            np.testing.assert_array_equal(getattr(joint, field), getattr(alone, field))
+        assert (joint.cost, joint.evaluations, joint.generations) == (
+            alone.cost, alone.evaluations, alone.generations)
