@@ -7,7 +7,8 @@ Outputs, written atomically into OUT (a failed run leaves OUT as it was):
 - ``measurements.json`` / ``.csv``: the 16 measurements with their spreads, mm;
 - ``convergence.png``: the best and mean cost per generation;
 - ``run.json``: inputs, settings, weights, seed, versions, timings, best cost, parameters,
-  the output folder and the working folder (``fitter run --config`` repeats the run);
+  the answers averaged into the fit's (``result.averaged``: each one's betas, angles and
+  cost), the output folder and the working folder (``fitter run --config`` repeats the run);
 - ``overlay_front.png``, ``overlay_side.png``: the person's and the fitted body's
   silhouettes with their matched contour points, coloured by part (the paper's Fig. 6/8);
 - ``report.html``: one self-contained page of all of it, for a person to read.
@@ -89,6 +90,9 @@ def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fi
             "stop_reasons": {k: str(v) for k, v in result.stop_reasons.items()},
             "best_cost_per_generation": result.best_costs.tolist(),
             "best_betas_per_generation": result.best_betas.round(4).tolist(),
+            "averaged": [{"betas": r.betas.tolist(),
+                          "pose_deg": dict(zip(POSE_NAMES, r.pose_deg.tolist())),
+                          "cost": r.cost} for r in result.averaged_from],
         },
         "timings_s": {k: round(v, 3) for k, v in fit.seconds.items()},
     }

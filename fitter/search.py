@@ -160,6 +160,8 @@ class SearchResult:
             ``final_costs`` (P,) its costs.
         evaluations: candidates scored; generations: G; seconds: wall time.
         stop_reasons: the optimiser's reasons for stopping.
+        averaged_from: the results whose answers were averaged into this one
+            (:func:`averaged`; after :func:`refined`, the refinements'); () for one search.
     """
 
     betas: np.ndarray
@@ -175,6 +177,7 @@ class SearchResult:
     generations: int
     seconds: float
     stop_reasons: dict
+    averaged_from: tuple["SearchResult", ...] = ()
 
 
 class _Search:
@@ -346,7 +349,8 @@ def averaged(results: list[SearchResult], betas: np.ndarray, pose_deg: np.ndarra
         evaluations=sum(r.evaluations for r in results),
         generations=max(r.generations for r in results),
         seconds=sum(r.seconds for r in results),
-        stop_reasons={k: v for r in results for k, v in r.stop_reasons.items()})
+        stop_reasons={k: v for r in results for k, v in r.stop_reasons.items()},
+        averaged_from=tuple(results))
 
 
 def refined(first: SearchResult, refinement: SearchResult) -> SearchResult:

@@ -136,6 +136,17 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
     np.testing.assert_allclose(answers[:4, :20], searches["best_betas_per_generation"])
     assert not answers[:4, 20:].any() and answers[4:, 20:].any()
     assert not np.allclose(refined["betas"], results["one"]["betas"])
+    # run.json holds the answers averaged: the four refinements' (run side by side; the
+    # first equals the refinement of the same seed run alone), the two searches' without
+    # refinements, none for one refinement
+    four = refined["averaged"]
+    assert len(four) == 4 and len(searches["averaged"]) == 2 and results["one"]["averaged"] == []
+    assert four[0]["betas"] == results["one"]["betas"]
+    np.testing.assert_allclose(np.mean([a["betas"] for a in four], axis=0)[1:],
+                               refined["betas"][1:], atol=1e-9)
+    for joint, angle in refined["pose_deg"].items():
+        assert angle == pytest.approx(np.mean([a["pose_deg"][joint] for a in four]))
+    assert all(a["cost"] > 0 for a in four)
     assert sum(refined["part_costs"].values()) == pytest.approx(refined["best_cost"],
                                                                 rel=1e-5)
     assert "24 components, 3 generations, 4 averaged" in (tmp_path / "refined"
