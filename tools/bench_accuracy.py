@@ -20,6 +20,8 @@
         --main "in-space=SETS/in:docs/accuracy-runs/in-space/default+default-b"
     # how far calib's extracted outlines lie from the exact silhouettes, per refinement passes
     python tools/bench_accuracy.py outlines SETS/in --first 10 --passes 1 2 4
+    # other ways to combine the refinements' answers a run's fits averaged (run.json)
+    python tools/bench_accuracy.py combine SETS/in default
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
@@ -63,18 +65,21 @@ from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, error_p
                                              fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean_of_important,
                                             measurement_table)
-from bodyfit.fitter.accuracy.scores import (KEYS, TRUTHS_FILE, RunScores, read_scores,
-                                            truth_records)
+from bodyfit.fitter.accuracy.scores import (IMPORTANT_COLUMNS, KEYS, TRUTHS_FILE, RunScores,
+                                            error_stats, read_scores, truth_records)
 from bodyfit.fitter.batch.orchestration import BATCH_FILE
 from bodyfit.fitter.batch.tables import FAILURES_FILE, SUMMARY_FILE
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
                                                  read_settings, read_truth, subject_ids,
                                                  write_bodies, write_photos_of_set)
-from bodyfit.fitter.body_model import PART_NAMES, project_shape, rest_shape
-from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, project_shape, rest_shape
+from bodyfit.fitter.canvas import extreme_bodies
+from bodyfit.fitter.fit import stature_conditioner
+from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
-from bodyfit.fitter.stature import scaled_to_stature
+from bodyfit.fitter.run_config import run_config
+from bodyfit.fitter.stature import scaled_to_stature, stature_scale
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
 
@@ -237,6 +242,94 @@ def keep(args) -> None:
     fitted = read_scores(Path(args.set), run).ids
     (kept / TRUTHS_FILE).write_text(json.dumps(truth_records(Path(args.set), fitted), indent=1))
     print(f"{run} -> {kept}: {len(fitted)} fitted")
+
+
+#: combine's rules: name -> (the answers' genes (N, K + 4), their costs (N,)) -> genes.
+COMBINATIONS = {
+    "the mean of all (the fit's)": lambda genes, costs: genes.mean(axis=0),
+    "the mean of the first two (seeds S, S + 1)": lambda genes, costs: genes[:2].mean(axis=0),
+    "the first alone (seed S)": lambda genes, costs: genes[0],
+    "the lowest-cost one": lambda genes, costs: genes[np.argmin(costs)],
+    "the mean of all but the highest-cost one":
+        lambda genes, costs: genes[np.argsort(costs)[:-1]].mean(axis=0),
+    "the median, gene by gene": lambda genes, costs: np.median(genes, axis=0),
+}
+
+
+def combine(args) -> None:
+    """Other ways to combine the answers a run's fits averaged (run.json's
+    ``result.averaged``: the refinements' betas, angles and costs), each body formed as
+    the fit forms its average (the first beta solved anew from the stature, the rest
+    body rescaled to it) and measured: the 7 important measurements' mean |error| per
+    rule and its difference from the fit's own, paired. Also how often the truth lies
+    within the single answers' scatter (their standard deviation, each measurement).
+    The first rule rebuilds each fit's own measurements (printed: the largest
+    difference from measurements.json, a round trip)."""
+    folder, run = Path(args.set), Path(args.set) / "runs" / args.name
+    model = load_model()
+    measurer = Measurer.from_model(model)
+    errors = {name: [] for name in COMBINATIONS}
+    scatter, own_errors, round_trip = [], [], 0.0
+    for row in (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]:
+        subject = row.split(",")[0]
+        record_file = run / subject / "run.json"
+        if not record_file.exists():
+            continue
+        record = json.loads(record_file.read_text())
+        answers = record["result"].get("averaged", [])
+        if len(answers) < 2:
+            continue
+        settings = run_config(record).settings
+        stature_m = record["inputs"]["height_cm"] / 100.0
+        search = settings.search.refinement() if settings.search.refine_components \
+            else settings.search
+        bodies = extreme_bodies(model, search.components, search.pose_lower_deg,
+                                search.pose_upper_deg, settings.canvas.beta_limit)
+        conditioner = stature_conditioner(model, dataclasses.replace(settings, search=search),
+                                          stature_m, bodies)
+        genes = np.array([a["betas"] + [a["pose_deg"][n] for n in POSE_NAMES]
+                          for a in answers])
+        costs = np.array([a["cost"] for a in answers])
+        truth = read_truth(folder / subject)
+
+        def measured(combined: np.ndarray) -> np.ndarray:
+            betas, pose = combined[None, :-len(POSE_NAMES)], combined[None, -len(POSE_NAMES):]
+            if conditioner is not None:
+                betas = conditioner.complete(betas[:, 1:], pose)
+            rest = rest_shape(model, betas)[0][0]
+            if conditioner is not None:
+                rest = rest * stature_scale(rest, stature_m)
+            values = measurer.measure(rest)
+            return np.array([values[key] - truth[key] for key in KEYS])
+
+        for name, rule in COMBINATIONS.items():
+            errors[name].append(measured(rule(genes, costs)))
+        written = json.loads((run / subject / "measurements.json").read_text())["measurements"]
+        own = np.array([written[name]["value_mm"] - truth[key]
+                        for key, (name, _) in zip(KEYS, MEASUREMENTS.values())])
+        rebuilt = errors[next(iter(COMBINATIONS))][-1]
+        round_trip = max(round_trip, float(np.abs(own - rebuilt).max()))
+        singles = np.array([measured(g) for g in genes])
+        scatter.append(singles.std(axis=0, ddof=1))
+        own_errors.append(own)
+    count = len(own_errors)
+    if count < 2:
+        sys.exit(f"{run}: fewer than 2 fits record the answers they averaged")
+    fit = np.array(errors[next(iter(COMBINATIONS))])
+    print(f"{run}: {count} subjects whose fits averaged {len(answers)} answers; the fit's "
+          f"measurements rebuilt to within {round_trip:.3f} mm\n\n| combination | 7 important, "
+          "mean abs. error (95 % CI) | paired with the fit's |\n|---|---|---|")
+    for name, values in errors.items():
+        values = np.array(values)
+        mean, _, ci = mean_of_important(values)
+        per_subject = (np.abs(values[:, IMPORTANT_COLUMNS]).mean(axis=1)
+                       - np.abs(fit[:, IMPORTANT_COLUMNS]).mean(axis=1))
+        difference = error_stats(per_subject[:, None])
+        print(f"| {name} | {mean:.2f} (±{ci:.2f}) | {difference.bias[0]:+.2f} ± "
+              f"{difference.bias_ci[0]:.2f} |")
+    within = np.mean(np.abs(np.array(own_errors)) <= np.array(scatter), axis=0)
+    print("\nThe truth within the single answers' scatter (1 sd), per measurement: "
+          + ", ".join(f"{key} {share:.0%}" for key, share in zip(KEYS, within)))
 
 
 def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
@@ -406,6 +499,11 @@ def main() -> None:
     p.add_argument("name", help="the run's name (SET/runs/NAME)")
     p.add_argument("--to", default="docs/accuracy-runs",
                    help="folder of kept runs: TO/<set kind>/NAME/ (default: %(default)s)")
+    p = sub.add_parser("combine", help="other ways to combine the answers a run's fits "
+                       "averaged")
+    p.add_argument("set")
+    p.add_argument("name", help="the run's name (SET/runs/NAME)")
+    p.add_argument("--first", type=int, help="the set's first N subjects only")
     p = sub.add_parser("report", help="Markdown tables of runs")
     p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "
@@ -438,8 +536,8 @@ def main() -> None:
     if args.command == "fit":
         fit(args, batch_options)
     else:
-        {"make": make, "keep": keep, "report": report, "outlines": outlines, "floor": floor,
-         "figures": figures}[args.command](args)
+        {"make": make, "keep": keep, "combine": combine, "report": report,
+         "outlines": outlines, "floor": floor, "figures": figures}[args.command](args)
 
 
 if __name__ == "__main__":

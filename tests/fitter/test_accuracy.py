@@ -169,6 +169,12 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     printed = tool("floor", str(subject_set), "--first", "4", "--components", "5", "20")
     floor = {int(m[1]): float(m[2]) for m in re.finditer(r"\| (\d+) \| ([.\d]+) \(", printed)}
     assert floor[20] < 0.05 and floor[5] > 1.0
+    # other combinations of the refinements' answers: the first rule, their mean, rebuilds
+    # each fit's own measurements from run.json (round trip)
+    printed = tool("combine", str(subject_set), "small")
+    assert float(re.search(r"rebuilt to within ([.\d]+) mm", printed)[1]) < 0.02
+    assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) .* \| \+0\.00 ± 0\.00 \|",
+                     printed)[1] == f"{mean7:.2f}"
     # the rest of a set: rows 2-3 only (all fitted already in this run: it resumes, fits none)
     tool("fit", str(subject_set), "small", "--first", "4", "--skip", "2")
     rows = (subject_set / "subjects-rows2-3.csv").read_text().splitlines()
