@@ -244,11 +244,19 @@ def keep(args) -> None:
     print(f"{run} -> {kept}: {len(fitted)} fitted")
 
 
-#: combine's rules: name -> (the answers' genes (N, K + 4), their costs (N,)) -> genes.
+def _combinations(count: int) -> dict:
+    """combine's rules for ``count`` answers: name -> (the answers' genes (N, K + 4), their
+    costs (N,)) -> genes; the first is the fit's own (the mean of all), then the mean of
+    the first n (seeds S to S + n - 1: what ``--refinements n`` gives) for every n <
+    ``count``, then the rules of ``COMBINATIONS``."""
+    firsts = {f"the mean of the first {n}" if n > 1 else "the first alone":
+              (lambda genes, costs, n=n: genes[:n].mean(axis=0)) for n in range(1, count)}
+    return {"the mean of all (the fit's)": lambda genes, costs: genes.mean(axis=0),
+            **firsts, **COMBINATIONS}
+
+
+#: combine's rules besides the means of the first n (:func:`_combinations`).
 COMBINATIONS = {
-    "the mean of all (the fit's)": lambda genes, costs: genes.mean(axis=0),
-    "the mean of the first two (seeds S, S + 1)": lambda genes, costs: genes[:2].mean(axis=0),
-    "the first alone (seed S)": lambda genes, costs: genes[0],
     "the lowest-cost one": lambda genes, costs: genes[np.argmin(costs)],
     "the mean of all but the highest-cost one":
         lambda genes, costs: genes[np.argsort(costs)[:-1]].mean(axis=0),
@@ -258,7 +266,8 @@ COMBINATIONS = {
 
 def combine(args) -> None:
     """Other ways to combine the answers a run's fits averaged (run.json's
-    ``result.averaged``: the refinements' betas, angles and costs), each body formed as
+    ``result.averaged``: the refinements' betas, angles and costs), among them the mean of
+    the first n (fewer refinements, from the same run), each body formed as
     the fit forms its average (the first beta solved anew from the stature, the rest
     body rescaled to it) and measured: the 7 important measurements' mean |error| per
     rule and its difference from the fit's own, paired. Also how often the truth lies
@@ -268,7 +277,7 @@ def combine(args) -> None:
     folder, run = Path(args.set), Path(args.set) / "runs" / args.name
     model = load_model()
     measurer = Measurer.from_model(model)
-    errors = {name: [] for name in COMBINATIONS}
+    errors, counts = {}, set()
     scatter, own_errors, round_trip = [], [], 0.0
     for row in (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]:
         subject = row.split(",")[0]
@@ -302,12 +311,15 @@ def combine(args) -> None:
             values = measurer.measure(rest)
             return np.array([values[key] - truth[key] for key in KEYS])
 
-        for name, rule in COMBINATIONS.items():
-            errors[name].append(measured(rule(genes, costs)))
+        counts.add(len(answers))
+        if len(counts) > 1:
+            sys.exit(f"{run}: its fits averaged different numbers of answers ({sorted(counts)})")
+        for name, rule in _combinations(len(answers)).items():
+            errors.setdefault(name, []).append(measured(rule(genes, costs)))
         written = json.loads((run / subject / "measurements.json").read_text())["measurements"]
         own = np.array([written[name]["value_mm"] - truth[key]
                         for key, (name, _) in zip(KEYS, MEASUREMENTS.values())])
-        rebuilt = errors[next(iter(COMBINATIONS))][-1]
+        rebuilt = errors["the mean of all (the fit's)"][-1]
         round_trip = max(round_trip, float(np.abs(own - rebuilt).max()))
         singles = np.array([measured(g) for g in genes])
         scatter.append(singles.std(axis=0, ddof=1))
@@ -315,7 +327,7 @@ def combine(args) -> None:
     count = len(own_errors)
     if count < 2:
         sys.exit(f"{run}: fewer than 2 fits record the answers they averaged")
-    fit = np.array(errors[next(iter(COMBINATIONS))])
+    fit = np.array(errors["the mean of all (the fit's)"])
     print(f"{run}: {count} subjects whose fits averaged {len(answers)} answers; the fit's "
           f"measurements rebuilt to within {round_trip:.3f} mm\n\n| combination | 7 important, "
           "mean abs. error (95 % CI) | paired with the fit's |\n|---|---|---|")
