@@ -79,7 +79,7 @@ from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import run_config
-from bodyfit.fitter.stature import scaled_to_stature, stature_scale
+from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
 
@@ -300,28 +300,26 @@ def combine(args) -> None:
                           for a in answers])
         costs = np.array([a["cost"] for a in answers])
         truth = read_truth(folder / subject)
-
-        def measured(combined: np.ndarray) -> np.ndarray:
-            betas, pose = combined[None, :-len(POSE_NAMES)], combined[None, -len(POSE_NAMES):]
-            if conditioner is not None:
-                betas = conditioner.complete(betas[:, 1:], pose)
-            rest = rest_shape(model, betas)[0][0]
-            if conditioner is not None:
-                rest = rest * stature_scale(rest, stature_m)
-            values = measurer.measure(rest)
-            return np.array([values[key] - truth[key] for key in KEYS])
-
         counts.add(len(answers))
         if len(counts) > 1:
             sys.exit(f"{run}: its fits averaged different numbers of answers ({sorted(counts)})")
-        for name, rule in _combinations(len(answers)).items():
-            errors.setdefault(name, []).append(measured(rule(genes, costs)))
+        rules = _combinations(len(answers))
+        # every rule's body, then each answer's own, formed as the fit forms its average
+        combined = np.array([rule(genes, costs) for rule in rules.values()] + list(genes))
+        betas, pose = combined[:, :-len(POSE_NAMES)], combined[:, -len(POSE_NAMES):]
+        if conditioner is not None:
+            betas = conditioner.complete(betas[:, 1:], pose)
+        rest = rest_shape(model, betas)[0]
+        if conditioner is not None:
+            rest = scaled_to_stature(rest, stature_m)
+        measured = measurer.measure_many(rest) - np.array([truth[key] for key in KEYS])
+        for name, values in zip(rules, measured):
+            errors.setdefault(name, []).append(values)
         written = json.loads((run / subject / "measurements.json").read_text())["measurements"]
         own = np.array([written[name]["value_mm"] - truth[key]
                         for key, (name, _) in zip(KEYS, MEASUREMENTS.values())])
-        rebuilt = errors["the mean of all (the fit's)"][-1]
-        round_trip = max(round_trip, float(np.abs(own - rebuilt).max()))
-        singles = np.array([measured(g) for g in genes])
+        round_trip = max(round_trip, float(np.abs(own - measured[0]).max()))
+        singles = measured[len(rules):]
         scatter.append(singles.std(axis=0, ddof=1))
         own_errors.append(own)
     count = len(own_errors)
