@@ -251,10 +251,12 @@ def _combinations(count: int) -> dict:
     ``count``, then the rules of ``COMBINATIONS``."""
     firsts = {f"the mean of the first {n}" if n > 1 else "the first alone":
               (lambda genes, costs, n=n: genes[:n].mean(axis=0)) for n in range(1, count)}
-    return {"the mean of all (the fit's)": lambda genes, costs: genes.mean(axis=0),
+    return {FIT_RULE: lambda genes, costs: genes.mean(axis=0),
             **firsts, **COMBINATIONS}
 
 
+#: combine's first rule, the fit's own: the mean of all the answers.
+FIT_RULE = "the mean of all (the fit's)"
 #: combine's rules besides the means of the first n (:func:`_combinations`).
 COMBINATIONS = {
     "the lowest-cost one": lambda genes, costs: genes[np.argmin(costs)],
@@ -325,7 +327,7 @@ def combine(args) -> None:
     count = len(own_errors)
     if count < 2:
         sys.exit(f"{run}: fewer than 2 fits record the answers they averaged")
-    fit = np.array(errors["the mean of all (the fit's)"])
+    fit = np.array(errors[FIT_RULE])
     print(f"{run}: {count} subjects whose fits averaged {len(answers)} answers; the fit's "
           f"measurements rebuilt to within {round_trip:.3f} mm\n\n| combination | 7 important, "
           "mean abs. error (95 % CI) | paired with the fit's |\n|---|---|---|")
