@@ -31,8 +31,8 @@ from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, statur
 from bodyfit.fitter.weights import cost_settings
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "placement_body",
-           "stature_conditioner"]
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "person_views", "place_cameras",
+           "placement_body", "refinement_scoring", "stature_conditioner"]
 
 _SPREAD_SHARE = 0.25
 _SPREAD_MIN = 3
@@ -171,6 +171,23 @@ def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
                              settings.device, **view_options)
 
 
+def person_views(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
+                 settings: FitSettings, intrinsics: dict[str, np.ndarray] | None,
+                 bodies: np.ndarray) -> dict[str, kernels.ViewTarget]:
+    """{"front": view, "side": view}: the targets a fit's search starts on (pinhole cameras
+    placed from the mean body), of :func:`fit_person`'s arguments; ``bodies``: the search's
+    extreme bodies (:func:`~bodyfit.fitter.canvas.extreme_bodies` over
+    ``settings.search.components``), whose extent the canvases cover."""
+    s = settings.search
+    mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
+    # arms turned down in the frontal plane keep their side-view width and stay above
+    # the feet, so the extent of the search's pose range covers them
+    options = {"front": {}, "side": side_view_options(model, settings.side_arms)}
+    return {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m,
+                        bodies.reshape(-1, 3), mean_body, model, settings, options[name])
+            for name in ("front", "side")}
+
+
 def stature_conditioner(model: BodyModel, settings: FitSettings, stature_m: float,
                         bodies: np.ndarray) -> StatureConditioner | None:
     """The fit's :class:`~bodyfit.fitter.stature.StatureConditioner` (None without
@@ -220,7 +237,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     return body[shown].astype(np.float64)
 
 
-def _place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
+def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
                    betas: np.ndarray, pose_deg: np.ndarray) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
     degrees) as the kernels render it (:func:`placement_body`,
@@ -235,7 +252,7 @@ def _place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settin
 
 def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, settings):
     """The search's ``on_generation`` that places the pinhole cameras anew from the best
-    body so far (:func:`_place_cameras`) after each of ``settings.placement_rounds``
+    body so far (:func:`place_cameras`) after each of ``settings.placement_rounds``
     evenly spaced generations."""
     generations = settings.search.generations or 1
     rounds = settings.placement_rounds
@@ -246,7 +263,7 @@ def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, set
     def place(done: int, betas: np.ndarray, pose_deg: np.ndarray) -> bool:
         if done not in at:
             return False
-        _place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
+        place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
                        betas, pose_deg)
         return True
 
@@ -275,7 +292,7 @@ def _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner
                               progress, replace))
     if len(results) == 1:
         return results[0]
-    place = (functools.partial(_place_cameras, model, views, masks, intrinsics, stature_m,
+    place = (functools.partial(place_cameras, model, views, masks, intrinsics, stature_m,
                                evaluator, settings) if placing else None)
     return _mean_of(results, evaluator, conditioner, place)
 
@@ -295,6 +312,18 @@ def _mean_of(results: list[SearchResult], evaluator, conditioner, place=None) ->
     return averaged(results, betas, pose, float(scored.costs[0]), scored.part_costs[0])
 
 
+def refinement_scoring(model: BodyModel, views: dict[str, kernels.ViewTarget],
+                       stature_m: float, settings: FitSettings):
+    """(evaluator, stature conditioner or None) of the refinement
+    (``settings.search.refinement()``: its ``refine_components``) over ``views``."""
+    s = settings.search
+    refinement = s.refinement()
+    bodies = extreme_bodies(model, refinement.components, s.pose_lower_deg, s.pose_upper_deg,
+                            settings.canvas.beta_limit)
+    return _scoring(model, views, dataclasses.replace(settings, search=refinement), stature_m,
+                    bodies)
+
+
 def _refined(model, views, stature_m, first: SearchResult, settings, progress) -> SearchResult:
     """The refinement (``SearchSettings.refine_components``) of ``first``'s answer:
     ``refinements`` searches (seeds ``seed``, ``seed + 1``, ...), each started from that
@@ -302,13 +331,8 @@ def _refined(model, views, stature_m, first: SearchResult, settings, progress) -
     (:func:`~bodyfit.fitter.search.searches_together`); several averaged by
     :func:`_mean_of` (the cameras kept); joined to ``first`` by
     :func:`~bodyfit.fitter.search.refined`."""
-    s = settings.search
-    refinement = s.refinement()
-    bodies = extreme_bodies(model, refinement.components, s.pose_lower_deg, s.pose_upper_deg,
-                            settings.canvas.beta_limit)
-    evaluator, conditioner = _scoring(model, views, dataclasses.replace(settings,
-                                                                        search=refinement),
-                                      stature_m, bodies)
+    refinement = settings.search.refinement()
+    evaluator, conditioner = refinement_scoring(model, views, stature_m, settings)
     betas = np.r_[first.betas, np.zeros(refinement.components - len(first.betas))]
     start = np.r_[betas[len(betas) - refinement.searched_betas:], first.pose_deg]
     seeds = [dataclasses.replace(refinement, seed=refinement.seed + i)
@@ -345,14 +369,7 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     t0 = time.perf_counter()
     bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
                             settings.canvas.beta_limit)
-    extent = bodies.reshape(-1, 3)
-    mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
-    # arms turned down in the frontal plane keep their side-view width and stay above
-    # the feet, so the extent of the search's pose range covers them
-    options = {"front": {}, "side": side_view_options(model, settings.side_arms)}
-    views = {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m, extent,
-                         mean_body, model, settings, options[name])
-             for name in ("front", "side")}
+    views = person_views(model, masks, stature_m, settings, intrinsics, bodies)
     evaluator, conditioner = _scoring(model, views, settings, stature_m, bodies)
     t1 = time.perf_counter()
     result = _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner,

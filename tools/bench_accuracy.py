@@ -24,6 +24,8 @@
     python tools/bench_accuracy.py combine SETS/in default
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
+    # does the cost tell the truth's closest body from the fit's answer (search or photos?)
+    python tools/bench_accuracy.py costs SETS/out default --first 30
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python tools/bench_accuracy.py figures SETS/in --curve "bodyfit=default" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -69,6 +71,7 @@ from bodyfit.fitter.accuracy.scores import (IMPORTANT_COLUMNS, KEYS, TRUTHS_FILE
                                             error_stats, read_scores, truth_records)
 from bodyfit.fitter.batch.orchestration import BATCH_FILE
 from bodyfit.fitter.batch.tables import FAILURES_FILE, SUMMARY_FILE
+from bodyfit.fitter.accuracy.truth_costs import compare_costs
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
                                                  read_settings, read_truth, subject_ids,
                                                  write_bodies, write_photos_of_set)
@@ -224,6 +227,46 @@ def floor(args) -> None:
                   for rows in (hard, ~hard)]
         print(f"| {k} | {mean:.2f} (±{ci:.2f}) | {' | '.join(shares)} | "
               + " | ".join(f"{v:.1f}" for v in np.abs(errors).mean(axis=0)) + " |")
+
+
+def costs(args) -> None:
+    """The fit's answers against each truth's closest body of the fit's space, scored on
+    the fit's own views (:mod:`bodyfit.fitter.accuracy.truth_costs`): Markdown rows of the
+    paired cost differences (truth minus answer: negative, the search stopped short of a
+    cheaper body nearer the truth) with their 95 % CI, and per part against the fit's
+    answer."""
+    folder, run = Path(args.set), Path(args.set) / "runs" / args.name
+    model = load_model()
+    bodies = read_bodies(model, folder)
+    found = []
+    for index, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex)[:args.first]):
+        if (run / subject / "run.json").exists():
+            found.append(compare_costs(model, run / subject / "run.json",
+                                       bodies.vertices[index], bodies.joints[index]))
+    if len(found) < 2:
+        sys.exit(f"{run}: fewer than 2 fitted subjects")
+    averaged = [c for c in found if len(c.answers)]  # fits that record their answers
+    against = [("the fit's answer", found, lambda c: c.fit),
+               ("the cheapest answer it averaged", averaged, lambda c: c.answers.min()),
+               ("the answers it averaged, on average", averaged, lambda c: c.answers.mean())]
+    print(f"{run}: the truth's closest body of the fit's space (its angles searched) against "
+          "the fit, on the fit's views; cost, weighted mm\n\n| against | subjects | its mean "
+          "cost | the truth's | truth minus it (95 % CI) | the truth cheaper |\n"
+          "|---|---|---|---|---|---|")
+    for name, comparisons, cost in against:
+        if len(comparisons) < 2:
+            continue
+        values = np.array([cost(c) for c in comparisons])
+        truth = np.array([c.truth for c in comparisons])
+        difference = error_stats((truth - values)[:, None])
+        print(f"| {name} | {len(comparisons)} | {values.mean():.2f} | {truth.mean():.2f} | "
+              f"{difference.bias[0]:+.2f} ± {difference.bias_ci[0]:.2f} | "
+              f"{np.sum(truth < values)} |")
+    parts = error_stats(np.array([c.truth_parts - c.fit_parts for c in found]))
+    cheaper = np.sum([c.truth_parts < c.fit_parts for c in found], axis=0)
+    print("\n| part | truth minus the fit's answer (95 % CI) | the truth cheaper |\n|---|---|---|")
+    for j, name in enumerate(PART_NAMES):
+        print(f"| {name} | {parts.bias[j]:+.2f} ± {parts.bias_ci[j]:.2f} | {cheaper[j]} |")
 
 
 def keep(args) -> None:
@@ -533,6 +576,11 @@ def main() -> None:
     p.add_argument("set")
     p.add_argument("--first", type=int, default=100, help="the set's first N subjects")
     p.add_argument("--components", type=int, nargs="+", default=[20, 40, 60], metavar="K")
+    p = sub.add_parser("costs", help="the fit's answers against the truth's closest body, "
+                       "scored on the fit's views")
+    p.add_argument("set")
+    p.add_argument("name", help="the run's name (SET/runs/NAME)")
+    p.add_argument("--first", type=int, default=30, help="the set's first N subjects")
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
@@ -549,7 +597,8 @@ def main() -> None:
         fit(args, batch_options)
     else:
         {"make": make, "keep": keep, "combine": combine, "report": report,
-         "outlines": outlines, "floor": floor, "figures": figures}[args.command](args)
+         "outlines": outlines, "floor": floor, "costs": costs,
+         "figures": figures}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -175,6 +175,12 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert float(re.search(r"rebuilt to within ([.\d]+) mm", printed)[1]) < 0.02
     assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) .* \| \+0\.00 ± 0\.00 \|",
                      printed)[1] == f"{mean7:.2f}"
+    # the truth's closest body scored on the fit's views: drawn from the space the fit
+    # searches, it is cheaper than a 60-generation search's answer
+    printed = tool("costs", str(subject_set), "small", "--first", "2")
+    row = re.search(r"\| the fit's answer \| 2 \| ([.\d]+) \| ([.\d]+) \| \S+ ± [.\d]+ \| (\d) \|",
+                    printed)
+    assert float(row[2]) < float(row[1]) and row[3] == "2"
     # the rest of a set: rows 2-3 only (all fitted already in this run: it resumes, fits none)
     tool("fit", str(subject_set), "small", "--first", "4", "--skip", "2")
     rows = (subject_set / "subjects-rows2-3.csv").read_text().splitlines()
