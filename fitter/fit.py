@@ -238,7 +238,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
 
 
 def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
-                   betas: np.ndarray, pose_deg: np.ndarray) -> None:
+                  betas: np.ndarray, pose_deg: np.ndarray) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
     degrees) as the kernels render it (:func:`placement_body`,
     :func:`~bodyfit.fitter.pinhole_canvas.placed_anew`); updates ``views`` and the
@@ -264,7 +264,7 @@ def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, set
         if done not in at:
             return False
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
-                       betas, pose_deg)
+                      betas, pose_deg)
         return True
 
     return place

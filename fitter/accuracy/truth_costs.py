@@ -25,11 +25,11 @@ from pathlib import Path
 import cma
 import numpy as np
 
-from bodyfit.fitter.body_model import POSE_NAMES, BodyModel, project_shape
+from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, BodyModel, project_shape
 from bodyfit.fitter.canvas import extreme_bodies
 from bodyfit.fitter.fit import person_views, place_cameras, refinement_scoring
 from bodyfit.fitter.person import person_masks, view_intrinsics
-from bodyfit.fitter.run_config import read_run_config
+from bodyfit.fitter.run_config import run_config
 
 __all__ = ["CostComparison", "POSE_POPULATION", "POSE_GENERATIONS", "POSE_SIGMA0_DEG",
            "compare_costs"]
@@ -55,19 +55,19 @@ class CostComparison:
     truth_parts: np.ndarray
 
 
-def _genes(record: dict) -> tuple[np.ndarray, np.ndarray]:
+def _genes(answer: dict) -> tuple[np.ndarray, np.ndarray]:
     """(betas (K,), pose (4,) degrees) of a run.json answer record."""
-    return (np.asarray(record["betas"], np.float64),
-            np.array([record["pose_deg"][name] for name in POSE_NAMES], np.float64))
+    return (np.asarray(answer["betas"], np.float64),
+            np.array([answer["pose_deg"][name] for name in POSE_NAMES], np.float64))
 
 
 def compare_costs(model: BodyModel, run_json: Path, vertices: np.ndarray,
                   joints: np.ndarray, seed: int = 1) -> CostComparison:
     """The fit of ``run_json`` against the truth (rest ``vertices`` (V, 3), ``joints``
     (4, 3), metres) on the fit's views (see the module docstring)."""
-    config = read_run_config(run_json)
-    settings, inputs = config.settings, config.inputs
-    result = json.loads(Path(run_json).read_text())["result"]
+    record = json.loads(Path(run_json).read_text())
+    config = run_config(record, str(run_json))
+    settings, inputs, result = config.settings, config.inputs, record["result"]
     masks = person_masks(inputs)
     intrinsics = (view_intrinsics(inputs, masks) if settings.projection == "pinhole"
                   else None)
@@ -99,10 +99,10 @@ def compare_costs(model: BodyModel, run_json: Path, vertices: np.ndarray,
         poses = np.asarray(angles.ask())
         angles.tell(poses, evaluator.evaluate(shaped(poses), poses).costs.tolist())
     truth_pose = np.asarray(angles.result.xbest, np.float64)[None]
-    answers = [_genes(record) for record in result.get("averaged", [])]
+    answers = [_genes(answer) for answer in result.get("averaged", [])]
     scored = evaluator.evaluate(
         np.stack([fit_betas, shaped(truth_pose)[0]] + [b for b, _ in answers]),
         np.stack([fit_pose, truth_pose[0]] + [p for _, p in answers]))
     costs, parts = scored.costs.astype(np.float64), scored.part_costs.astype(np.float64)
-    return CostComparison(float(costs[0]), costs[2:], float(costs[1]), parts[0, :9],
-                          parts[1, :9])
+    parts = parts[:, :len(PART_NAMES)]  # the top and bottom terms are not parts
+    return CostComparison(float(costs[0]), costs[2:], float(costs[1]), parts[0], parts[1])
