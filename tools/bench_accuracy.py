@@ -26,6 +26,9 @@
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # does the cost tell the truth's closest body from the fit's answer (search or photos?)
     python tools/bench_accuracy.py costs SETS/out default --first 30
+    # the error had each refinement run G generations only (0: the searches' answer), read
+    # from one run at the longest budget
+    python tools/bench_accuracy.py budgets SETS/out long --generations 0 250 500
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python tools/bench_accuracy.py figures SETS/in --curve "bodyfit=default" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -63,7 +66,7 @@ import numpy as np
 from bodyfit.calib.images import write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.fitter.accuracy.bodies import KINDS, pose_bodies
-from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, error_per_generation,
+from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, errors_per_generation,
                                              fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean_of_important,
                                             measurement_table)
@@ -81,7 +84,7 @@ from bodyfit.fitter.fit import stature_conditioner
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.plots import line_chart
-from bodyfit.fitter.run_config import run_config
+from bodyfit.fitter.run_config import read_run_config, run_config
 from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
@@ -267,6 +270,46 @@ def costs(args) -> None:
     print("\n| part | truth minus the fit's answer (95 % CI) | the truth cheaper |\n|---|---|---|")
     for j, name in enumerate(PART_NAMES):
         print(f"| {name} | {parts.bias[j]:+.2f} ± {parts.bias_ci[j]:.2f} | {cheaper[j]} |")
+
+
+def budgets(args) -> None:
+    """A run's fits as shorter refinements would have answered them: Markdown rows of the 7
+    important measurements' error for each refinement budget, paired with the first.
+
+    A refinement's first G generations do not depend on its budget (CMA-ES's state does not
+    know it; the same seeds draw the same candidates), and run.json records the
+    refinements' mean answer after every generation, so one run at the longest budget holds
+    every shorter one's answer on the same subjects (each stood to the stature as
+    ``figures`` stands it: the run's own error for the last generation). 0: the searches'
+    answer, before any refinement."""
+    folder, run = Path(args.set), Path(args.set) / "runs" / args.name
+    model = load_model()
+    bodies = read_bodies(model, folder)
+    fitted = [s for s in subject_ids(len(bodies.sex), bodies.sex)[:args.first]
+              if (run / s / "run.json").exists()]
+    if len(fitted) < 2:
+        sys.exit(f"{run}: fewer than 2 fitted subjects")
+    searches = {(c.search.generations, c.search.refine_generations) for c in
+                (read_run_config(run / s / "run.json").settings for s in fitted)}
+    if len(searches) > 1:
+        sys.exit(f"{run}: its fits ran different budgets {sorted(searches)}")
+    (generations, longest), = searches
+    if max(args.generations) > longest:
+        sys.exit(f"{run}: its refinements ran {longest} generations, fewer than "
+                 f"{max(args.generations)}")
+    errors = errors_per_generation(model, bodies, run, [generations + g for g in args.generations],
+                                   set(fitted))  # (S, G, 7)
+    means = errors.mean(axis=2)
+    print(f"{run}: {len(fitted)} subjects, as each refinement's first G generations answered "
+          "(mm)\n\n| G | " + " | ".join(KEYS[j] for j in IMPORTANT_COLUMNS)
+          + f" | 7 important (95 % CI) | paired with G = {args.generations[0]} (95 % CI) | "
+          "better for |\n" + "|---" * (len(IMPORTANT_COLUMNS) + 4) + "|")
+    for column, budget in enumerate(args.generations):
+        mean = error_stats(means[:, [column]])
+        paired = error_stats((means[:, column] - means[:, 0])[:, None])
+        print(f"| {budget} | " + " | ".join(f"{e:.1f}" for e in errors[:, column].mean(axis=0))
+              + f" | {mean.mae[0]:.2f} (±{mean.mae_ci[0]:.2f}) | {paired.bias[0]:+.2f} ± "
+              f"{paired.bias_ci[0]:.2f} | {np.sum(means[:, column] < means[:, 0])} |")
 
 
 def keep(args) -> None:
@@ -496,7 +539,8 @@ def figures(args) -> None:
     common = {s for s in ids if all((run / s / "run.json").exists() for run in runs.values())}
     curves = {}
     for label, run in runs.items():
-        curves[label] = error_per_generation(model, bodies, run, generations, common)
+        curves[label] = errors_per_generation(model, bodies, run, generations,
+                                              common).mean(axis=(0, 2))
         print(f"{label}: " + ", ".join(f"g{g} {e:.1f}" for g, e in zip(generations,
                                                                       curves[label])))
     chart = line_chart(curves, f"{args.title}, {len(common)} subjects: the answer so far",
@@ -581,6 +625,12 @@ def main() -> None:
     p.add_argument("set")
     p.add_argument("name", help="the run's name (SET/runs/NAME)")
     p.add_argument("--first", type=int, default=30, help="the set's first N subjects")
+    p = sub.add_parser("budgets", help="the error had the refinements run fewer generations")
+    p.add_argument("set")
+    p.add_argument("name", help="the run's name (SET/runs/NAME)")
+    p.add_argument("--first", type=int, help="the set's first N subjects only")
+    p.add_argument("--generations", type=int, nargs="+", default=[0, 250, 500], metavar="G",
+                   help="each refinement's generations (0: the searches' answer)")
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
@@ -597,7 +647,7 @@ def main() -> None:
         fit(args, batch_options)
     else:
         {"make": make, "keep": keep, "combine": combine, "report": report,
-         "outlines": outlines, "floor": floor, "costs": costs,
+         "outlines": outlines, "floor": floor, "costs": costs, "budgets": budgets,
          "figures": figures}[args.command](args)
 
 

@@ -23,7 +23,7 @@ from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.render import render_colours
 
-__all__ = ["error_per_generation", "distance_panel", "colour_bar", "fitted_rest_body"]
+__all__ = ["errors_per_generation", "distance_panel", "colour_bar", "fitted_rest_body"]
 
 
 def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
@@ -41,12 +41,12 @@ def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
     return rest
 
 
-def error_per_generation(model: BodyModel, bodies: Bodies, run_folder: Path,
-                         generations: list[int], subjects: set[str]) -> np.ndarray:
-    """(len(generations),) mean |error| (mm) of the 7 important measurements of the body
-    answered after each of ``generations`` (1-based), over ``subjects`` (ids whose
-    run.json the run has); ``bodies``: the set's (:func:`.subject_set.read_bodies`); the
-    last generation's is the run's own error."""
+def errors_per_generation(model: BodyModel, bodies: Bodies, run_folder: Path,
+                          generations: list[int], subjects: set[str]) -> np.ndarray:
+    """(S, len(generations), 7) |error| (mm) of the 7 important measurements of the body
+    answered after each of ``generations`` (1-based), for the S ``subjects`` (ids whose
+    run.json the run has) in the set's order; ``bodies``: the set's
+    (:func:`.subject_set.read_bodies`); the last generation's is the run's own error."""
     measurer = Measurer.from_model(model)
     errors = []
     for index, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex)):
@@ -57,8 +57,8 @@ def error_per_generation(model: BodyModel, bodies: Bodies, run_folder: Path,
         for vertices in _rest_bodies(model, run_folder, subject, generations):
             measured = measurer.measure(vertices)
             rows.append([abs(measured[KEYS[j]] - truth[KEYS[j]]) for j in IMPORTANT_COLUMNS])
-        errors.append(np.mean(rows, axis=1))
-    return np.mean(errors, axis=0)
+        errors.append(rows)
+    return np.array(errors)
 
 
 def fitted_rest_body(model: BodyModel, run_folder: Path, subject: str) -> np.ndarray:

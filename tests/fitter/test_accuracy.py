@@ -158,6 +158,14 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert last == pytest.approx(mean7, abs=0.06)
     for name in ("accuracy_error_per_generation.png", "accuracy_meshes.png"):
         assert cv2.imread(str(tmp_path / name)) is not None
+    # shorter refinements read from the same run: its own budget gives its own error (round
+    # trip); a budget longer than the run's is refused
+    printed = tool("budgets", str(subject_set), "small", "--generations", "0", "10", "20")
+    longest = re.search(r"\| 20 \|(?: [.\d]+ \|){7} ([.\d]+) \(", printed)
+    assert float(longest[1]) == pytest.approx(mean7, abs=0.06)
+    beyond = subprocess.run([sys.executable, str(TOOL), "budgets", str(subject_set), "small",
+                             "--generations", "30"], env=env, capture_output=True, text=True)
+    assert beyond.returncode != 0 and "fewer than 30" in beyond.stderr
     # calib's silhouettes of the JPEGs against the geometry's exact coverage: with the
     # default passes on the edge within a tenth of a pixel, one pass clearly outside
     printed = tool("outlines", str(subject_set), "--first", "2", "--passes", "1", "4")
