@@ -27,8 +27,8 @@
     # does the cost tell the truth's closest body from the fit's answer (search or photos?)
     python tools/bench_accuracy.py costs SETS/out default --first 30
     # the error had each refinement run G generations only (0: the searches' answer), read
-    # from one run at the longest budget
-    python tools/bench_accuracy.py budgets SETS/out long --generations 0 250 500
+    # from runs at the longest budget (several: joined)
+    python tools/bench_accuracy.py budgets SETS/out long long-b --generations 0 250 500
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python tools/bench_accuracy.py figures SETS/in --curve "bodyfit=default" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -272,8 +272,23 @@ def costs(args) -> None:
         print(f"| {name} | {parts.bias[j]:+.2f} ± {parts.bias_ci[j]:.2f} | {cheaper[j]} |")
 
 
+def _budget_errors(model, bodies, run: Path, subjects: list[str],
+                   budgets: list[int]) -> np.ndarray:
+    """(S, len(budgets), 7) |error| (mm) of the 7 important measurements of ``run``'s fits
+    of ``subjects`` had each refinement run ``budgets`` generations (see :func:`budgets`)."""
+    searches = {(c.search.generations, c.search.refine_generations) for c in
+                (read_run_config(run / s / "run.json").settings for s in subjects)}
+    if len(searches) > 1:
+        sys.exit(f"{run}: its fits ran different budgets {sorted(searches)}")
+    (generations, longest), = searches
+    if max(budgets) > longest:
+        sys.exit(f"{run}: its refinements ran {longest} generations, fewer than {max(budgets)}")
+    return errors_per_generation(model, bodies, run, [generations + g for g in budgets],
+                                 set(subjects))
+
+
 def budgets(args) -> None:
-    """A run's fits as shorter refinements would have answered them: Markdown rows of the 7
+    """Runs' fits as shorter refinements would have answered them: Markdown rows of the 7
     important measurements' error for each refinement budget, paired with the first.
 
     A refinement's first G generations do not depend on its budget (CMA-ES's state does not
@@ -281,27 +296,25 @@ def budgets(args) -> None:
     refinements' mean answer after every generation, so one run at the longest budget holds
     every shorter one's answer on the same subjects (each stood to the stature as
     ``figures`` stands it: the run's own error for the last generation). 0: the searches'
-    answer, before any refinement."""
-    folder, run = Path(args.set), Path(args.set) / "runs" / args.name
+    answer, before any refinement. Several runs are joined, each subject from the first
+    run holding it."""
+    folder = Path(args.set)
     model = load_model()
     bodies = read_bodies(model, folder)
-    fitted = [s for s in subject_ids(len(bodies.sex), bodies.sex)[:args.first]
-              if (run / s / "run.json").exists()]
-    if len(fitted) < 2:
-        sys.exit(f"{run}: fewer than 2 fitted subjects")
-    searches = {(c.search.generations, c.search.refine_generations) for c in
-                (read_run_config(run / s / "run.json").settings for s in fitted)}
-    if len(searches) > 1:
-        sys.exit(f"{run}: its fits ran different budgets {sorted(searches)}")
-    (generations, longest), = searches
-    if max(args.generations) > longest:
-        sys.exit(f"{run}: its refinements ran {longest} generations, fewer than "
-                 f"{max(args.generations)}")
-    errors = errors_per_generation(model, bodies, run, [generations + g for g in args.generations],
-                                   set(fitted))  # (S, G, 7)
+    ids, seen, errors = subject_ids(len(bodies.sex), bodies.sex)[:args.first], set(), []
+    for name in args.names:
+        run = folder / "runs" / name
+        fitted = [s for s in ids if s not in seen and (run / s / "run.json").exists()]
+        if fitted:
+            errors.append(_budget_errors(model, bodies, run, fitted, args.generations))
+        seen.update(fitted)
+    if len(seen) < 2:
+        sys.exit(f"{folder}: fewer than 2 subjects fitted by {', '.join(args.names)}")
+    errors = np.concatenate(errors)  # (S, G, 7)
     means = errors.mean(axis=2)
-    print(f"{run}: {len(fitted)} subjects, as each refinement's first G generations answered "
-          "(mm)\n\n| G | " + " | ".join(KEYS[j] for j in IMPORTANT_COLUMNS)
+    print(f"{folder}: {'+'.join(args.names)}, {len(seen)} subjects, as each refinement's "
+          "first G generations answered (mm)\n\n| G | "
+          + " | ".join(KEYS[j] for j in IMPORTANT_COLUMNS)
           + f" | 7 important (95 % CI) | paired with G = {args.generations[0]} (95 % CI) | "
           "better for |\n" + "|---" * (len(IMPORTANT_COLUMNS) + 4) + "|")
     for column, budget in enumerate(args.generations):
@@ -627,7 +640,8 @@ def main() -> None:
     p.add_argument("--first", type=int, default=30, help="the set's first N subjects")
     p = sub.add_parser("budgets", help="the error had the refinements run fewer generations")
     p.add_argument("set")
-    p.add_argument("name", help="the run's name (SET/runs/NAME)")
+    p.add_argument("names", nargs="+", metavar="name",
+                   help="runs' names (SET/runs/NAME), joined: each subject from the first")
     p.add_argument("--first", type=int, help="the set's first N subjects only")
     p.add_argument("--generations", type=int, nargs="+", default=[0, 250, 500], metavar="G",
                    help="each refinement's generations (0: the searches' answer)")
