@@ -69,7 +69,10 @@ class SearchSettings:
             gained 2.0 mm out-of-space and lost 0.6 in-space (200 subjects of each set),
             four gained 0.4 mm more in each set (the first 40; docs/accuracy.md, "Pushing
             the numbers", steps 14-16). 0: none (the paper).
-        refine_generations: each refinement's generations.
+        refine_generations: each refinement's generations. 500 against 250: -0.25 mm
+            in-space and -0.67 out-of-space on 20 subjects of each set, for 1.6x the
+            time; the refinements converge (cma stops) by about 900, 750 gained 0.1 mm
+            more out-of-space only (docs/accuracy.md, step 19).
         refinements: how many refinements are averaged. Their answers scatter about the
             body the silhouettes fix, each by about its error (the cost is flat across
             millimetres of shape), so their mean is nearer: four against two, -0.42 mm
@@ -89,7 +92,7 @@ class SearchSettings:
     condition_stature: bool = True
     searches: int = 2
     refine_components: int = 40
-    refine_generations: int = 250
+    refine_generations: int = 500
     refinements: int = 4
 
     def validate(self, stored_components: int) -> None:
