@@ -276,8 +276,9 @@ def _budget_errors(model, bodies, run: Path, subjects: list[str],
                    budgets: list[int]) -> np.ndarray:
     """(S, len(budgets), 7) |error| (mm) of the 7 important measurements of ``run``'s fits
     of ``subjects`` had each refinement run ``budgets`` generations (see :func:`budgets`)."""
-    searches = {(c.search.generations, c.search.refine_generations) for c in
-                (read_run_config(run / s / "run.json").settings for s in subjects)}
+    searches = {(c.search.generations, c.search.refine_generations
+                 if c.search.refine_components else 0)  # 0: no refinement
+                for c in (read_run_config(run / s / "run.json").settings for s in subjects)}
     if len(searches) > 1:
         sys.exit(f"{run}: its fits ran different budgets {sorted(searches)}")
     (generations, longest), = searches
