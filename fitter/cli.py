@@ -111,7 +111,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "than --components; default 40, none when --components is 40 "
                              "or more; 0: none; --method paper: 0)")
     parser.add_argument("--refine-generations", type=int,
-                        help="each refinement's generations (default 250)")
+                        help="each refinement's generations (default 500)")
     parser.add_argument("--refinements", type=int,
                         help="refinements (seeds SEED, SEED+1, ...) whose answers are averaged "
                              "(default 4)")

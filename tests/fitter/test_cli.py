@@ -95,6 +95,26 @@ def test_version_and_usage_errors(capsys):
     assert code == 0 and all(c in out for c in ("run", "demo", "measure", "model"))
 
 
+@pytest.mark.parametrize("command", ["run", "batch"])
+def test_help_states_the_search_defaults(capsys, command):
+    """The help's "(default N)" of each search option is SearchSettings' own default."""
+    import re
+
+    from bodyfit.fitter.search import SearchSettings
+
+    code, out, _ = run(capsys, command, "--help")
+    assert code == 0
+    text = " ".join(out.split())
+    defaults = SearchSettings()
+    for option, value in (("--population", defaults.population),
+                          ("--generations", defaults.generations),
+                          ("--searches", defaults.searches),
+                          ("--refine-generations", defaults.refine_generations),
+                          ("--refinements", defaults.refinements)):
+        stated = re.search(rf"{option} [A-Z_]+ (?:(?! --[a-z]).)*?\(default (\d+)", text)
+        assert stated and int(stated.group(1)) == value, option
+
+
 def test_demo_with_a_corrupt_user_model_exits_2(tmp_path, capsys):
     from bodyfit.fitter import model_cache
 
