@@ -375,19 +375,31 @@ def combine(args) -> None:
     rule and its difference from the fit's own, paired. Also how often the truth lies
     within the single answers' scatter (their standard deviation, each measurement).
     The first rule rebuilds each fit's own measurements (printed: the largest
-    difference from measurements.json, a round trip)."""
-    folder, run = Path(args.set), Path(args.set) / "runs" / args.name
+    difference from measurements.json, a round trip). Several runs are joined, each
+    subject from the first run holding it; ``--answers N`` takes each fit's first N
+    answers only (what ``--refinements N`` gives: the refinements do not depend on their
+    count), so runs of more refinements join runs of N as N's fits."""
+    folder = Path(args.set)
     model = load_model()
     measurer = Measurer.from_model(model)
     errors, counts = {}, set()
-    scatter, own_errors, round_trip = [], [], 0.0
+    scatter, own_errors, round_trip, rebuilt = [], [], 0.0, 0
     for row in (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]:
         subject = row.split(",")[0]
-        record_file = run / subject / "run.json"
-        if not record_file.exists():
+        held = [folder / "runs" / name for name in args.names
+                if (folder / "runs" / name / subject / "run.json").exists()]
+        if not held:
             continue
-        record = json.loads(record_file.read_text())
+        run = held[0]
+        record = json.loads((run / subject / "run.json").read_text())
         answers = record["result"].get("averaged", [])
+        if args.answers is not None:
+            if len(answers) < args.answers:
+                sys.exit(f"{run / subject}: its fit averaged {len(answers)} answers, fewer "
+                         f"than --answers {args.answers}")
+            truncated, answers = args.answers < len(answers), answers[:args.answers]
+        else:
+            truncated = False
         if len(answers) < 2:
             continue
         settings = run_config(record).settings
@@ -404,7 +416,8 @@ def combine(args) -> None:
         truth = read_truth(folder / subject)
         counts.add(len(answers))
         if len(counts) > 1:
-            sys.exit(f"{run}: its fits averaged different numbers of answers ({sorted(counts)})")
+            sys.exit(f"{'+'.join(args.names)}: their fits averaged different numbers of "
+                     f"answers ({sorted(counts)}; --answers N takes the first N)")
         rules = _combinations(len(answers))
         # every rule's body, then each answer's own, formed as the fit forms its average
         combined = np.array([rule(genes, costs) for rule in rules.values()] + list(genes))
@@ -417,20 +430,24 @@ def combine(args) -> None:
         measured = measurer.measure_many(rest) - np.array([truth[key] for key in KEYS])
         for name, values in zip(rules, measured):
             errors.setdefault(name, []).append(values)
-        written = json.loads((run / subject / "measurements.json").read_text())["measurements"]
-        own = np.array([written[name]["value_mm"] - truth[key]
-                        for key, (name, _) in zip(KEYS, MEASUREMENTS.values())])
-        round_trip = max(round_trip, float(np.abs(own - measured[0]).max()))
+        if not truncated:
+            written = json.loads((run / subject / "measurements.json").read_text())
+            own = np.array([written["measurements"][name]["value_mm"] - truth[key]
+                            for key, (name, _) in zip(KEYS, MEASUREMENTS.values())])
+            round_trip = max(round_trip, float(np.abs(own - measured[0]).max()))
+            rebuilt += 1
         singles = measured[len(rules):]
         scatter.append(singles.std(axis=0, ddof=1))
-        own_errors.append(own)
+        own_errors.append(measured[0])
     count = len(own_errors)
     if count < 2:
-        sys.exit(f"{run}: fewer than 2 fits record the answers they averaged")
+        sys.exit(f"{'+'.join(args.names)}: fewer than 2 fits record the answers they averaged")
     fit = np.array(errors[FIT_RULE])
-    print(f"{run}: {count} subjects whose fits averaged {len(answers)} answers; the fit's "
-          f"measurements rebuilt to within {round_trip:.3f} mm\n\n| combination | 7 important, "
-          "mean abs. error (95 % CI) | paired with the fit's |\n|---|---|---|")
+    print(f"{folder}: {'+'.join(args.names)}, {count} subjects whose fits averaged "
+          f"{len(answers)} answers" + (f"; the fit's measurements rebuilt to within "
+                                       f"{round_trip:.3f} mm ({rebuilt} fits)" if rebuilt else "")
+          + "\n\n| combination | 7 important, mean abs. error (95 % CI) | paired with the "
+          "fit's |\n|---|---|---|")
     for name, values in errors.items():
         values = np.array(values)
         mean, _, ci = mean_of_important(values)
@@ -615,8 +632,11 @@ def main() -> None:
     p = sub.add_parser("combine", help="other ways to combine the answers a run's fits "
                        "averaged")
     p.add_argument("set")
-    p.add_argument("name", help="the run's name (SET/runs/NAME)")
+    p.add_argument("names", nargs="+", metavar="name",
+                   help="runs' names (SET/runs/NAME), joined: each subject from the first")
     p.add_argument("--first", type=int, help="the set's first N subjects only")
+    p.add_argument("--answers", type=int, metavar="N",
+                   help="each fit's first N answers only (as --refinements N would give)")
     p = sub.add_parser("report", help="Markdown tables of runs")
     p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "

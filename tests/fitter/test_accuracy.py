@@ -183,6 +183,11 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert float(re.search(r"rebuilt to within ([.\d]+) mm", printed)[1]) < 0.02
     assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) .* \| \+0\.00 ± 0\.00 \|",
                      printed)[1] == f"{mean7:.2f}"
+    # each fit's first three answers only: as the mean of the first three of all four
+    first3 = re.search(r"\| the mean of the first 3 \| ([.\d]+) ", printed)[1]
+    printed = tool("combine", str(subject_set), "small", "--answers", "3")
+    assert "averaged 3 answers" in printed and "rebuilt" not in printed
+    assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) ", printed)[1] == first3
     # the truth's closest body scored on the fit's views: drawn from the space the fit
     # searches, it is cheaper than a 60-generation search's answer
     printed = tool("costs", str(subject_set), "small", "--first", "2")
