@@ -272,6 +272,22 @@ def costs(args) -> None:
         print(f"| {name} | {parts.bias[j]:+.2f} ± {parts.bias_ci[j]:.2f} | {cheaper[j]} |")
 
 
+def _joined(runs: list[Path], held) -> list[tuple[Path, set[str]]]:
+    """Runs joined into one (a run continued in another session or on another machine):
+    each run with the subjects ``held(run)`` that no run before it holds."""
+    seen, parts = set(), []
+    for run in runs:
+        own = set(held(run)) - seen
+        parts.append((run, own))
+        seen |= own
+    return parts
+
+
+def _fit_records(subjects: list[str]):
+    """``held`` for :func:`_joined`: the ``subjects`` a run's folder holds a fit record of."""
+    return lambda run: {s for s in subjects if (run / s / "run.json").exists()}
+
+
 def _budget_errors(model, bodies, run: Path, subjects: list[str],
                    budgets: list[int]) -> np.ndarray:
     """(S, len(budgets), 7) |error| (mm) of the 7 important measurements of ``run``'s fits
@@ -302,18 +318,15 @@ def budgets(args) -> None:
     folder = Path(args.set)
     model = load_model()
     bodies = read_bodies(model, folder)
-    ids, seen, errors = subject_ids(len(bodies.sex), bodies.sex)[:args.first], set(), []
-    for name in args.names:
-        run = folder / "runs" / name
-        fitted = [s for s in ids if s not in seen and (run / s / "run.json").exists()]
-        if fitted:
-            errors.append(_budget_errors(model, bodies, run, fitted, args.generations))
-        seen.update(fitted)
-    if len(seen) < 2:
+    ids = subject_ids(len(bodies.sex), bodies.sex)[:args.first]
+    parts = _joined([folder / "runs" / name for name in args.names], _fit_records(ids))
+    if sum(len(own) for _, own in parts) < 2:
         sys.exit(f"{folder}: fewer than 2 subjects fitted by {', '.join(args.names)}")
+    errors = [_budget_errors(model, bodies, run, [s for s in ids if s in own],
+                             args.generations) for run, own in parts if own]
     errors = np.concatenate(errors)  # (S, G, 7)
     means = errors.mean(axis=2)
-    print(f"{folder}: {'+'.join(args.names)}, {len(seen)} subjects, as each refinement's "
+    print(f"{folder}: {'+'.join(args.names)}, {len(errors)} subjects, as each refinement's "
           "first G generations answered (mm)\n\n| G | "
           + " | ".join(KEYS[j] for j in IMPORTANT_COLUMNS)
           + f" | 7 important (95 % CI) | paired with G = {args.generations[0]} (95 % CI) | "
@@ -326,9 +339,16 @@ def budgets(args) -> None:
               f"{paired.bias_ci[0]:.2f} | {np.sum(means[:, column] < means[:, 0])} |")
 
 
+#: run.json's per-generation histories (``figures``, ``budgets``): what ``keep`` leaves out
+#: of the fit records it keeps (about 220 of their 230 kB).
+_HISTORIES = ("best_cost_per_generation", "best_betas_per_generation")
+
+
 def keep(args) -> None:
-    """Copy a run's tables (what `report` reads) out of the set, to be committed: a set is
-    remade by `make` from its seed, a run's per-subject folders are not kept."""
+    """Copy a run's tables (what `report` reads) out of the set, to be committed, and each
+    fit's record less its per-generation histories (``SUBJECT/run.json`` and
+    ``measurements.json``: what `combine` reads): a set is remade by `make` from its seed,
+    a run's photos, meshes and overlays are not kept."""
     run = Path(args.set) / "runs" / args.name
     if not (run / SUMMARY_FILE).exists():
         sys.exit(f"{run}: no {SUMMARY_FILE} (not a run of fitter batch)")
@@ -341,6 +361,12 @@ def keep(args) -> None:
             shutil.copyfile(source, kept / name)
     fitted = read_scores(Path(args.set), run).ids
     (kept / TRUTHS_FILE).write_text(json.dumps(truth_records(Path(args.set), fitted), indent=1))
+    for subject in fitted:
+        record = json.loads((run / subject / "run.json").read_text())
+        record["result"] = {k: v for k, v in record["result"].items() if k not in _HISTORIES}
+        (kept / subject).mkdir(exist_ok=True)
+        (kept / subject / "run.json").write_text(json.dumps(record, indent=1))
+        shutil.copyfile(run / subject / "measurements.json", kept / subject / "measurements.json")
     print(f"{run} -> {kept}: {len(fitted)} fitted")
 
 
@@ -375,31 +401,30 @@ def combine(args) -> None:
     rule and its difference from the fit's own, paired. Also how often the truth lies
     within the single answers' scatter (their standard deviation, each measurement).
     The first rule rebuilds each fit's own measurements (printed: the largest
-    difference from measurements.json, a round trip). Several runs are joined, each
-    subject from the first run holding it; ``--answers N`` takes each fit's first N
+    difference from measurements.json, a round trip). A run is a name or a folder of
+    `keep`; several runs are joined, each subject from the first run holding it;
+    ``--answers N`` takes each fit's first N
     answers only (what ``--refinements N`` gives: the refinements do not depend on their
     count), so runs of more refinements join runs of N as N's fits."""
     folder = Path(args.set)
     model = load_model()
     measurer = Measurer.from_model(model)
     errors, counts = {}, set()
-    scatter, own_errors, round_trip, rebuilt = [], [], 0.0, 0
-    for row in (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]:
-        subject = row.split(",")[0]
-        held = [folder / "runs" / name for name in args.names
-                if (folder / "runs" / name / subject / "run.json").exists()]
-        if not held:
-            continue
-        run = held[0]
+    scatter, round_trip, rebuilt = [], 0.0, 0
+    subjects = [row.split(",")[0] for row in
+                (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]]
+    holder = {subject: run for run, own in _joined(
+        [_run_folder(folder, name) for name in args.names], _fit_records(subjects))
+        for subject in own}
+    for subject in (s for s in subjects if s in holder):
+        run = holder[subject]
         record = json.loads((run / subject / "run.json").read_text())
         answers = record["result"].get("averaged", [])
-        if args.answers is not None:
-            if len(answers) < args.answers:
-                sys.exit(f"{run / subject}: its fit averaged {len(answers)} answers, fewer "
-                         f"than --answers {args.answers}")
-            truncated, answers = args.answers < len(answers), answers[:args.answers]
-        else:
-            truncated = False
+        if len(answers) < (args.answers or 0):
+            sys.exit(f"{run / subject}: its fit averaged {len(answers)} answers, fewer "
+                     f"than --answers {args.answers}")
+        truncated = len(answers) > (args.answers or len(answers))
+        answers = answers[:args.answers]
         if len(answers) < 2:
             continue
         settings = run_config(record).settings
@@ -436,13 +461,11 @@ def combine(args) -> None:
                             for key, (name, _) in zip(KEYS, MEASUREMENTS.values())])
             round_trip = max(round_trip, float(np.abs(own - measured[0]).max()))
             rebuilt += 1
-        singles = measured[len(rules):]
-        scatter.append(singles.std(axis=0, ddof=1))
-        own_errors.append(measured[0])
-    count = len(own_errors)
+        scatter.append(measured[len(rules):].std(axis=0, ddof=1))  # the single answers'
+    fit = np.array(errors.get(FIT_RULE, []))
+    count = len(fit)
     if count < 2:
         sys.exit(f"{'+'.join(args.names)}: fewer than 2 fits record the answers they averaged")
-    fit = np.array(errors[FIT_RULE])
     print(f"{folder}: {'+'.join(args.names)}, {count} subjects whose fits averaged "
           f"{len(answers)} answers" + (f"; the fit's measurements rebuilt to within "
                                        f"{round_trip:.3f} mm ({rebuilt} fits)" if rebuilt else "")
@@ -456,32 +479,33 @@ def combine(args) -> None:
         difference = error_stats(per_subject[:, None])
         print(f"| {name} | {mean:.2f} (±{ci:.2f}) | {difference.bias[0]:+.2f} ± "
               f"{difference.bias_ci[0]:.2f} |")
-    within = np.mean(np.abs(np.array(own_errors)) <= np.array(scatter), axis=0)
+    within = np.mean(np.abs(fit) <= np.array(scatter), axis=0)
     print("\nThe truth within the single answers' scatter (1 sd), per measurement: "
           + ", ".join(f"{key} {share:.0%}" for key, share in zip(KEYS, within)))
 
 
+def _run_folder(set_folder: Path, name: str) -> Path:
+    """A run's folder: a name (SET/runs/NAME) or a folder of `keep` (a path holding a
+    "/")."""
+    return Path(name) if "/" in name else Path(set_folder) / "runs" / name
+
+
 def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
-    """LABEL=SET:RUN[+RUN...] -> (label, the set, the runs' folders); a RUN is a name
-    (SET/runs/RUN) or a folder of `keep` (a path holding a "/"). Several runs make one (a
-    run continued on another machine or in another session): each subject from the first
-    run holding it."""
+    """LABEL=SET:RUN[+RUN...] -> (label, the set, the runs' folders, :func:`_run_folder`).
+    Several runs make one (a run continued on another machine or in another session):
+    each subject from the first run holding it."""
     label, _, where = spec.partition("=")
     set_folder, _, names = where.rpartition(":")
-    return label, Path(set_folder), [Path(name) if "/" in name
-                                     else Path(set_folder) / "runs" / name
+    return label, Path(set_folder), [_run_folder(set_folder, name)
                                      for name in names.split("+")]
 
 
 def _run_scores(set_folder: Path, runs: list[Path], first: int | None) -> tuple[RunScores, str]:
     """The joined scores of ``runs`` (each subject from the first run holding it, fitted or
     failed), over the set's first ``first`` subjects, and where and how fast each part went."""
-    parts, seen = [], set()
-    for run in runs:
-        scores = read_scores(set_folder, run)
-        held = set(scores.ids) | {subject for subject, _ in scores.failures}
-        parts.append((run, _first(_subset(scores, held - seen), set_folder, first)))
-        seen |= held
+    every = {run: read_scores(set_folder, run) for run in runs}
+    parts = [(run, _first(_subset(every[run], own), set_folder, first)) for run, own in
+             _joined(runs, lambda run: every[run].ids + [s for s, _ in every[run].failures])]
     joined = dataclasses.replace(
         parts[0][1], ids=[i for _, s in parts for i in s.ids],
         failures=[f for _, s in parts for f in s.failures],
@@ -633,7 +657,8 @@ def main() -> None:
                        "averaged")
     p.add_argument("set")
     p.add_argument("names", nargs="+", metavar="name",
-                   help="runs' names (SET/runs/NAME), joined: each subject from the first")
+                   help="runs (SET/runs/NAME, or a folder of `keep`), joined: each "
+                   "subject from the first")
     p.add_argument("--first", type=int, help="the set's first N subjects only")
     p.add_argument("--answers", type=int, metavar="N",
                    help="each fit's first N answers only (as --refinements N would give)")
@@ -662,7 +687,8 @@ def main() -> None:
     p = sub.add_parser("budgets", help="the error had the refinements run fewer generations")
     p.add_argument("set")
     p.add_argument("names", nargs="+", metavar="name",
-                   help="runs' names (SET/runs/NAME), joined: each subject from the first")
+                   help="runs (SET/runs/NAME, or a folder of `keep`), joined: each "
+                   "subject from the first")
     p.add_argument("--first", type=int, help="the set's first N subjects only")
     p.add_argument("--generations", type=int, nargs="+", default=[0, 250, 500], metavar="G",
                    help="each refinement's generations (0: the searches' answer)")

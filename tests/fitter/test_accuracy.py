@@ -3,6 +3,7 @@ small run of the whole benchmark (tools/bench_accuracy.py) whose report must sho
 working fitter."""
 
 import dataclasses
+import json
 import os
 import re
 import shutil
@@ -136,8 +137,13 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     # (A+B), report as the one run they split
     tool("keep", str(subject_set), "small", "--to", str(tmp_path / "kept"))
     kept = tmp_path / "kept" / "in-space"
-    assert {p.name for p in (kept / "small").iterdir()} == {
+    assert {p.name for p in (kept / "small").iterdir() if p.is_file()} == {
         "summary.csv", "failures.csv", "batch.json", "bench.json", "set.json", "truths.json"}
+    # ... and each fit's record less its per-generation histories (for `combine`)
+    records = sorted((kept / "small").glob("*/run.json"))
+    assert [r.parent.name for r in records] == sorted(p.parent.name for p in
+                                                       subject_set.glob("s*/truth.json"))
+    assert "best_betas_per_generation" not in json.loads(records[0].read_text())["result"]
     shutil.copytree(kept / "small", kept / "first-half")
     lines = (kept / "small" / "summary.csv").read_text().splitlines(keepends=True)
     (kept / "first-half" / "summary.csv").write_text("".join(
@@ -185,6 +191,9 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
                      printed)[1] == f"{mean7:.2f}"
     # each fit's first three answers only: as the mean of the first three of all four
     first3 = re.search(r"\| the mean of the first 3 \| ([.\d]+) ", printed)[1]
+    # the kept records combine as the run's own (a round trip through `keep`)
+    from_kept = tool("combine", str(subject_set), str(kept / "small"))
+    assert from_kept.split("\n", 1)[1] == printed.split("\n", 1)[1]
     printed = tool("combine", str(subject_set), "small", "--answers", "3")
     assert "averaged 3 answers" in printed and "rebuilt" not in printed
     assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) ", printed)[1] == first3
