@@ -403,9 +403,9 @@ def combine(args) -> None:
     The first rule rebuilds each fit's own measurements (printed: the largest
     difference from measurements.json, a round trip). A run is a name or a folder of
     `keep`; several runs are joined, each subject from the first run holding it;
-    ``--answers N`` takes each fit's first N
-    answers only (what ``--refinements N`` gives: the refinements do not depend on their
-    count), so runs of more refinements join runs of N as N's fits."""
+    ``--answers N`` takes each fit's first N answers only (what ``--refinements N``
+    gives: the refinements do not depend on their count), so runs of more refinements
+    join runs of N as N's fits."""
     folder = Path(args.set)
     model = load_model()
     measurer = Measurer.from_model(model)
