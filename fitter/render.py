@@ -19,7 +19,7 @@ __all__ = ["PART_COLOURS_BGR", "render_parts", "render_colours", "orthographic_p
 
 #: One BGR colour per part, ``PART_NAMES`` order.
 PART_COLOURS_BGR = np.array([
-    (190, 190, 190),  # head
+    (170, 160, 0),    # head: teal (the person is grey in the overlays)
     (40, 40, 230),    # chest
     (0, 150, 255),    # waist
     (0, 220, 240),    # hip
