@@ -687,8 +687,8 @@ def main() -> None:
     p = sub.add_parser("budgets", help="the error had the refinements run fewer generations")
     p.add_argument("set")
     p.add_argument("names", nargs="+", metavar="name",
-                   help="runs (SET/runs/NAME, or a folder of `keep`), joined: each "
-                   "subject from the first")
+                   help="runs' names (SET/runs/NAME; not kept folders, which lack the "
+                   "per-generation histories), joined: each subject from the first")
     p.add_argument("--first", type=int, help="the set's first N subjects only")
     p.add_argument("--generations", type=int, nargs="+", default=[0, 250, 500], metavar="G",
                    help="each refinement's generations (0: the searches' answer)")
