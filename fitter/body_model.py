@@ -42,7 +42,7 @@ __all__ = [
 ]
 
 #: Bumped whenever the file layout or the build changes meaning; older caches are rebuilt.
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2  # 2: the neck part (labels 0-9)
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

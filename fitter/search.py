@@ -153,7 +153,7 @@ class SearchResult:
             ever scored is partly chosen by the raster's noise), else the best candidate.
         pose_deg: (4,) float64 the answer's pose, degrees, ``POSE_NAMES`` order.
         cost: the answer's cost, weighted millimetres.
-        part_costs: (11,) float32, the answer's terms (``kernels.TERM_NAMES``).
+        part_costs: (12,) float32, the answer's terms (``kernels.TERM_NAMES``).
         best_costs, mean_costs: (G,) per generation, the best so far and the mean of the
             finite costs of that generation.
         best_betas: (G, K) per generation, the betas the search would have answered with
@@ -336,7 +336,7 @@ def _padded(curves: list[np.ndarray]) -> np.ndarray:
 def averaged(results: list[SearchResult], betas: np.ndarray, pose_deg: np.ndarray,
              cost: float, part_costs: np.ndarray) -> SearchResult:
     """One result for several searches of a person whose answers were averaged into
-    (``betas`` (K,), ``pose_deg`` (4,)), scored ``cost`` with ``part_costs`` (11,).
+    (``betas`` (K,), ``pose_deg`` (4,)), scored ``cost`` with ``part_costs`` (12,).
 
     The per-generation curves are the searches' means (``best_betas``: the mean of their
     answers had they stopped there, as the averaged answer is formed); the final

@@ -6,9 +6,11 @@ millimetre distances (see :mod:`bodyfit.kernels.cost`); each is a finite number 
 
 Names (``WEIGHT_NAMES``):
 
-- the nine parts ``head``, ``chest``, ``waist``, ``hip``, ``leg``, ``foot``, ``arm``,
-  ``elbow``, ``hand``: each weighs the distances of the person's boundary points matched
-  to that part of the candidate;
+- the ten parts ``head``, ``chest``, ``waist``, ``hip``, ``leg``, ``foot``, ``arm``,
+  ``elbow``, ``hand``, ``neck``: each weighs the distances of the person's boundary points
+  matched to that part of the candidate. The first nine are Table 2's; ``neck`` is split
+  from its head part (:mod:`bodyfit.fitter.parts`) and every preset gives it the head's
+  weight, so a preset weighs the skull and neck as Table 2's head part does;
 - ``top``, ``bottom``: the highest- and lowest-point terms of Eq. 18. Table 2 also lists
   a "height" weight (5), but Eq. 18 has no separate height term: the stature is what the
   top and bottom terms measure, so the height weight is carried by them;
@@ -20,7 +22,8 @@ everything, would cost nothing).
 Presets (``PRESETS``):
 
 - ``paper``: Table 2 exactly (head 2, chest 5, waist 5, hip 5, leg 2, foot 1, arm 3,
-  elbow 2, hand 1, top 5, bottom 5, view.front 2, view.side 3), the kernels' default.
+  elbow 2, hand 1, top 5, bottom 5, view.front 2, view.side 3; neck 2, the head's), the
+  kernels' default.
 - ``bodyfit``: Table 2's part and view weights with ``top`` and ``bottom`` 0, the
   default of ``fitter run``: its candidates are conditioned on the stature
   (:mod:`bodyfit.fitter.stature`), so every candidate is as tall as the person and the
@@ -29,7 +32,7 @@ Presets (``PRESETS``):
 - ``uniform``: every name 1: the paper's equal-coefficients run of Fig. 17, which it
   shows to be less accurate than Table 2's (Fig. 16).
 - ``lower-body``: for trousers: hip 8, leg 6, waist 5, foot 2, top 5, bottom 5 (the
-  lowest point fixes leg length), chest 2, head 1, arm 1, elbow 1, hand 1, view.front 2,
+  lowest point fixes leg length), chest 2, head 1, neck 1, arm 1, elbow 1, hand 1, view.front 2,
   view.side 3. A trouser fit is set by the waistband, the seat (hip), the thighs and
   inseam (leg) and the hem (foot), so those outweigh Table 2's torso; the upper body keeps
   small weights so that it still steers the shape rather than being free to go wrong.
@@ -79,11 +82,11 @@ def _preset(*values: float) -> Mapping[str, float]:
 
 #: Preset name -> a weight for every name (see the module docstring).
 PRESETS: Mapping[str, Mapping[str, float]] = MappingProxyType({
-    #                head chest waist hip leg foot arm elbow hand top bottom front side
-    "paper": _preset(2, 5, 5, 5, 2, 1, 3, 2, 1, 5, 5, 2, 3),
-    "bodyfit": _preset(2, 5, 5, 5, 2, 1, 3, 2, 1, 0, 0, 2, 3),
-    "uniform": _preset(1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1),
-    "lower-body": _preset(1, 2, 5, 8, 6, 2, 1, 1, 1, 5, 5, 2, 3),
+    #                head chest waist hip leg foot arm elbow hand neck top bottom front side
+    "paper": _preset(2, 5, 5, 5, 2, 1, 3, 2, 1, 2, 5, 5, 2, 3),
+    "bodyfit": _preset(2, 5, 5, 5, 2, 1, 3, 2, 1, 2, 0, 0, 2, 3),
+    "uniform": _preset(1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1),
+    "lower-body": _preset(1, 2, 5, 8, 6, 2, 1, 1, 1, 1, 5, 5, 2, 3),
 })
 
 
@@ -198,7 +201,8 @@ def _check_not_degenerate(weights: Mapping[str, float], where: str) -> None:
 def settings_from_record(record: Mapping[str, float],
                          base: CostSettings = CostSettings()) -> CostSettings:
     """The cost settings of a weights record: ``base``'s matching choices with the record's
-    weights.
+    weights. A record without ``neck`` (run.json files from before bodyfit split the neck
+    from the head part) weighs the neck as its head, as those runs did.
 
     Raises:
         UserError: a missing or unknown name, a bad value, or no part or view weight > 0.
@@ -206,6 +210,8 @@ def settings_from_record(record: Mapping[str, float],
     where = "weights record"
     for name in record:
         _check_name(name, where)
+    if "neck" not in record and "head" in record:
+        record = {**record, "neck": record["head"]}  # written before the neck was a part
     missing = [name for name in WEIGHT_NAMES if name not in record]
     if missing:
         raise UserError(f"{where}: missing {', '.join(missing)}")

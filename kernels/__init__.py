@@ -9,7 +9,7 @@ The entry point for a fitter (one person, many generations)::
     side = kernels.prepare_view_target("side", side_mask, side_camera, mm_per_px,
                                        visible_parts=kernels.SIDE_VIEW_PARTS)
     evaluator = kernels.PopulationEvaluator(model, [front, side], kernels.CostSettings())
-    costs, part_costs = evaluator.evaluate(betas, pose_deg)   # (P,), (P, 11)
+    costs, part_costs = evaluator.evaluate(betas, pose_deg)   # (P,), (P, 12)
 
 Importing this package imports none of its modules (each name below is loaded on first
 use) and does not initialise Warp; the first kernel launch does. So the body model can

@@ -11,8 +11,10 @@ import numpy as np
 
 __all__ = ["PART_NAMES", "POSE_NAMES", "POSE_SIDES"]
 
-#: The nine body parts of the paper's Table 2, in label order (label = index).
-PART_NAMES = ("head", "chest", "waist", "hip", "leg", "foot", "arm", "elbow", "hand")
+#: The body parts, in label order (label = index): the nine of the paper's Table 2, then
+#: the neck, which bodyfit splits from the paper's head (skull and neck) so that it can be
+#: weighted on its own; appended last so that the nine keep their labels.
+PART_NAMES = ("head", "chest", "waist", "hip", "leg", "foot", "arm", "elbow", "hand", "neck")
 
 #: The paper's 4 pose DOF: abduction in the frontal plane, positive = limb moves away
 #: from the body's midline. Order of the ``pose`` columns and of the rig chains/joints.

@@ -18,7 +18,7 @@ while the rows, the stature, do not.
 
 Distances are measured in pixels and reported in millimetres at the person
 (``ViewTarget.millimetres_per_pixel``), so costs read as weighted millimetres. Each
-candidate's per-term breakdown (P, 11) holds the nine parts of ``PART_NAMES``, then the
+candidate's per-term breakdown (P, 12) holds the ten parts of ``PART_NAMES``, then the
 top and bottom terms, summed over the views with the view weights; its rows sum to the
 costs. A candidate with an empty silhouette in a view costs +inf.
 """
@@ -63,7 +63,8 @@ class CostSettings:
 
     Attributes:
         part_weights: one weight per part, in ``PART_NAMES`` order (head 2, chest 5,
-            waist 5, hip 5, leg 2, foot 1, arm 3, elbow 2, hand 1).
+            waist 5, hip 5, leg 2, foot 1, arm 3, elbow 2, hand 1; neck 2, the weight of
+            Table 2's head part, which holds the neck).
         top_weight, bottom_weight: the highest- and lowest-point terms (5 and 5).
         front_weight, side_weight: the view weights of Eq. 17 (2 and 3).
         matching: one of ``MATCHING_DIRECTIONS``; the paper's is ``"person_to_model"``.
@@ -73,7 +74,7 @@ class CostSettings:
             top and bottom rows; :func:`bodyfit.kernels.alignment.launch_alignment`).
     """
 
-    part_weights: tuple[float, ...] = (2.0, 5.0, 5.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0)
+    part_weights: tuple[float, ...] = (2.0, 5.0, 5.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0, 2.0)
     top_weight: float = 5.0
     bottom_weight: float = 5.0
     front_weight: float = 2.0
@@ -230,7 +231,7 @@ def launch_view_cost(params: CostParams, target: WarpSilhouetteMoments, distance
                      parts: wp.array, row_sums: wp.array, row_pixels: wp.array,
                      transforms: wp.array, extremes: wp.array, areas: wp.array,
                      term_costs: wp.array, costs: wp.array) -> None:
-    """Add one view's weighted terms to (P, 11) ``term_costs`` and (P,) ``costs``.
+    """Add one view's weighted terms to (P, 12) ``term_costs`` and (P,) ``costs``.
 
     Reads the person -> model matches (``distances``, ``parts``: (P, N)) when
     ``params.person_to_model`` > 0 and the model -> person row sums when

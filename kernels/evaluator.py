@@ -52,7 +52,7 @@ class PopulationCost(NamedTuple):
     Attributes:
         costs: (P,) float32, weighted millimetres (Eq. 17); +inf for a candidate whose
             silhouette is empty in a view.
-        part_costs: (P, 11) float32, the terms in ``TERM_NAMES`` order (nine parts, top,
+        part_costs: (P, 12) float32, the terms in ``TERM_NAMES`` order (ten parts, top,
             bottom), summed over the views with their weights; rows sum to ``costs``.
     """
 
@@ -320,6 +320,6 @@ def evaluate_population(model: ModelArrays, views: Sequence[ViewTarget], betas, 
         settings: weights and matching choices.
 
     Returns:
-        ``PopulationCost(costs (P,), part_costs (P, 11))``.
+        ``PopulationCost(costs (P,), part_costs (P, 12))``.
     """
     return PopulationEvaluator(model, views, settings).evaluate(betas, pose_deg)

@@ -106,7 +106,7 @@ def interpolate_distance(distance: np.ndarray, points: np.ndarray) -> np.ndarray
 
 
 def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) -> np.ndarray:
-    """(11,) float64 weighted terms (``TERM_NAMES``) of one candidate in one view, mm."""
+    """(12,) float64 weighted terms (``TERM_NAMES``) of one candidate in one view, mm."""
     moments = silhouette_moments(label_map >= 0)
     if moments.area_px == 0:
         return np.full(len(TERM_NAMES), np.inf)
@@ -144,7 +144,7 @@ def view_terms(label_map: np.ndarray, view: ViewTarget, settings: CostSettings) 
 def population_cost(model: SkinnableModel, betas: np.ndarray, pose_deg: np.ndarray,
                     views: list[ViewTarget], settings: CostSettings = CostSettings(),
                     supersample: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """The reference pipeline: costs (P,) and part costs (P, 11), float64, millimetres.
+    """The reference pipeline: costs (P,) and part costs (P, 12), float64, millimetres.
 
     Each view skins the candidates with its own pose (``ViewTarget.view_pose``: the
     candidates' angles, with the view's fixed angles put in).

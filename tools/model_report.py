@@ -164,7 +164,7 @@ def main() -> None:
              for view in ("front", "side")]
     write_image(args.docs / "model_parts.png", np.concatenate(views + [parts_legend(700)], axis=1))
     lines += ["## Part labels", "",
-              "The mean body, front and side, coloured by the paper's nine parts (Table 2); "
+              "The mean body, front and side, coloured by its ten parts (Table 2's nine and the neck); "
               "see `fitter/parts.py` for how they are derived.", "",
               "![part labels, front and side](model_parts.png)", ""]
     write_text(args.docs / "model.md", "\n".join(lines))

@@ -45,7 +45,7 @@ class CostComparison:
     Attributes:
         fit: the fit's answer's; answers: (n,) each answer it averaged (empty: none).
         truth: the truth's closest body's, its angles searched.
-        fit_parts, truth_parts: (9,) the two's part costs, ``PART_NAMES`` order.
+        fit_parts, truth_parts: (10,) the two's part costs, ``PART_NAMES`` order.
     """
 
     fit: float

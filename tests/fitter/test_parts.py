@@ -6,7 +6,7 @@ from scipy.spatial import cKDTree
 from bodyfit.fitter.body_model import PART_NAMES
 
 
-def test_every_vertex_has_one_of_the_nine_parts(body_model):
+def test_every_vertex_has_one_of_the_ten_parts(body_model):
     labels = body_model.vertex_parts
     assert labels.shape == (body_model.num_vertices,)
     assert labels.min() >= 0 and labels.max() < len(PART_NAMES)
@@ -31,7 +31,7 @@ def test_labels_are_left_right_symmetric(body_model):
 def test_parts_are_ordered_from_head_to_feet(body_model):
     z = body_model.mean_vertices[:, 2]
     height = {p: np.median(z[body_model.vertex_parts == i]) for i, p in enumerate(PART_NAMES)}
-    assert height["head"] > height["chest"] > height["waist"] > height["hip"] > height["leg"] > height["foot"]
+    assert height["head"] > height["neck"] > height["chest"] > height["waist"] > height["hip"] > height["leg"] > height["foot"]
     assert height["arm"] > height["elbow"] > height["hand"]
 
 

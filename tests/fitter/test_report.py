@@ -102,7 +102,7 @@ def test_run_json_round_trips_into_the_same_settings(first_run):
                               refine_components=0),
         projection="orthographic",
         cost=dataclasses.replace(FitSettings().cost,
-                                 part_weights=(2.0, 5.0, 7.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0)))
+                                 part_weights=(2.0, 5.0, 7.0, 5.0, 2.0, 1.0, 3.0, 2.0, 1.0, 2.0)))
     assert config.inputs.front.endswith("front.png") and config.output == first_run
     custom = FitSettings(search=SearchSettings(pose_lower_deg=(-5.0,) * 4, components=12),
                          cost=CostSettings(matching="symmetric", align_rotation=False),

@@ -18,8 +18,10 @@ from bodyfit.kernels import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, SIDE_VIEW_PARTS, TER
 from bodyfit.kernels.target import visible_faces
 
 #: Table 2 of the paper, its "height" row carried by top and bottom.
+#: The neck, split from Table 2's head part, weighs as the head.
 TABLE_2 = {"head": 2, "chest": 5, "waist": 5, "hip": 5, "leg": 2, "foot": 1, "arm": 3,
-           "elbow": 2, "hand": 1, "top": 5, "bottom": 5, "view.front": 2, "view.side": 3}
+           "elbow": 2, "hand": 1, "neck": 2, "top": 5, "bottom": 5, "view.front": 2,
+           "view.side": 3}
 
 
 def _one_line_error(call, *match):
@@ -38,7 +40,7 @@ def test_presets_have_the_documented_values():
     assert PRESETS["uniform"] == dict.fromkeys(WEIGHT_NAMES, 1.0)
     assert PRESETS["lower-body"] == {
         "head": 1, "chest": 2, "waist": 5, "hip": 8, "leg": 6, "foot": 2, "arm": 1, "elbow": 1,
-        "hand": 1, "top": 5, "bottom": 5, "view.front": 2, "view.side": 3}
+        "hand": 1, "neck": 1, "top": 5, "bottom": 5, "view.front": 2, "view.side": 3}
     assert list(PRESETS["paper"]) == list(WEIGHT_NAMES)
 
 
@@ -52,7 +54,7 @@ def test_paper_preset_is_the_kernels_default_and_bodyfit_the_fitters():
 
 def test_preset_settings_put_each_weight_in_its_field():
     settings = cost_settings("lower-body")
-    assert settings.part_weights == (1, 2, 5, 8, 6, 2, 1, 1, 1)
+    assert settings.part_weights == (1, 2, 5, 8, 6, 2, 1, 1, 1, 1)
     assert (settings.top_weight, settings.bottom_weight) == (5, 5)
     assert (settings.front_weight, settings.side_weight) == (2, 3)
 
@@ -165,6 +167,13 @@ def test_record_must_name_every_weight_once():
     _one_line_error(lambda: settings_from_record(record), "missing hip")
     _one_line_error(lambda: settings_from_record({**TABLE_2, "height": 5}), "'height'")
     _one_line_error(lambda: settings_from_record({**TABLE_2, "arm": -1}), ">= 0")
+
+
+def test_record_from_before_the_neck_part_weighs_the_neck_as_the_head():
+    old_record = {name: value for name, value in TABLE_2.items() if name != "neck"} | {"head": 4}
+    settings = settings_from_record(old_record)
+    assert settings.part_weights[PART_NAMES.index("neck")] == 4.0
+    assert weights_record(settings) == {**TABLE_2, "head": 4, "neck": 4}
 
 
 # --- the weights reach the kernels' cost ----------------------------------------------------

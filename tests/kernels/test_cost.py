@@ -191,7 +191,7 @@ def test_costs_are_the_same_on_every_device(body_model, model_arrays, views, tru
 
 @pytest.mark.parametrize("kwargs, message", [
     (dict(matching="both"), "matching must be one of"),
-    (dict(part_weights=(1.0,) * 8), "part_weights needs 9 values"),
+    (dict(part_weights=(1.0,) * 8), "part_weights needs 10 values"),
     (dict(top_weight=-1.0), ">= 0"),
 ])
 def test_settings_reject_bad_values(kwargs, message):
