@@ -69,7 +69,7 @@ from bodyfit.fitter.accuracy.bodies import KINDS, pose_bodies
 from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, errors_per_generation,
                                              fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean_of_important,
-                                            measurement_table)
+                                            measurement_table, paired_measurement_table)
 from bodyfit.fitter.accuracy.scores import (IMPORTANT_COLUMNS, KEYS, TRUTHS_FILE, RunScores,
                                             error_stats, read_scores, truth_records)
 from bodyfit.fitter.batch.orchestration import BATCH_FILE
@@ -561,6 +561,10 @@ def report(args) -> None:
         print(f"- {label}: {timing}")
     print("\n### The 7 important measurements (Table 4 form)\n")
     print("\n".join(important_table(table4, baselines)))
+    if args.per_measurement:
+        for label, baseline in baselines.items():
+            print(f"\n### {label} against {baseline}, measurement by measurement\n")
+            print("\n".join(paired_measurement_table(table4[label], table4[baseline])))
 
 
 def _first(scores, set_folder: Path, first: int | None):
@@ -670,6 +674,9 @@ def main() -> None:
                    help="a run in the Table 4 form only")
     p.add_argument("--first", type=int, help="every row over its set's first N subjects "
                    "only (compare runs of `fit --first N` with a full run)")
+    p.add_argument("--per-measurement", action="store_true",
+                   help="also each ablation against its set's first, measurement by "
+                   "measurement, over the subjects both fitted")
     p = sub.add_parser("outlines", help="extracted silhouettes against the exact ones")
     p.add_argument("set")
     p.add_argument("--first", type=int, default=10, help="the set's first N subjects")

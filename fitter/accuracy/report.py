@@ -21,7 +21,7 @@ from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
 
 __all__ = ["PAPER", "BEST_PUBLISHED", "ISO_ALLOWANCE_MM", "measurement_table",
            "important_table", "iso_verdicts", "failure_lines", "mean_of_important",
-           "paired_difference"]
+           "paired_difference", "paired_measurement_table"]
 
 #: The paper's Table 3 (mean, sd of |error|, mm), and its mean of the 7 important.
 PAPER = {"A": (3.1, 3.5), "B": (2.1, 2.0), "C": (2.2, 3.5), "D": (2.5, 3.2), "E": (5.1, 7.1),
@@ -83,15 +83,43 @@ def paired_difference(run: RunScores, baseline: RunScores) -> tuple[float, float
     """``run``'s 7-measurement mean |error| minus ``baseline``'s, subject by subject over
     the subjects both fitted: (mean difference, half-width of its 95 % interval (Student
     t), subjects), mm. Pairing removes the subjects' own difficulty from the comparison."""
+    ours, theirs = _paired_absolute(run, baseline)
+    important = (ours[:, IMPORTANT_COLUMNS].mean(axis=1)
+                 - theirs[:, IMPORTANT_COLUMNS].mean(axis=1))
+    s = error_stats(important[:, None])
+    return float(s.bias[0]), float(s.bias_ci[0]), len(ours)
+
+
+def _paired_absolute(run: RunScores, baseline: RunScores) -> tuple[np.ndarray, np.ndarray]:
+    """(S, 16) |error| of ``run`` and of ``baseline`` over the S subjects both fitted, in
+    the same subject order, mm."""
     common = sorted(set(run.ids) & set(baseline.ids))
 
-    def per_subject(scores: RunScores) -> np.ndarray:
+    def chosen(scores: RunScores) -> np.ndarray:
         row = {subject: i for i, subject in enumerate(scores.ids)}
-        chosen = np.abs(scores.errors[[row[s] for s in common]])[:, IMPORTANT_COLUMNS]
-        return chosen.mean(axis=1)
+        return np.abs(scores.errors[[row[s] for s in common]])
 
-    s = error_stats((per_subject(run) - per_subject(baseline))[:, None])
-    return float(s.bias[0]), float(s.bias_ci[0]), len(common)
+    return chosen(run), chosen(baseline)
+
+
+def paired_measurement_table(run: RunScores, baseline: RunScores) -> list[str]:
+    """Every measurement of ``run`` against ``baseline`` over the subjects both fitted:
+    each one's mean |error|, the mean of their subject-by-subject difference with its 95 %
+    interval (Student t) and for how many subjects ``run`` came closer, mm; then the
+    same for the 7 important measurements' mean."""
+    ours, theirs = _paired_absolute(run, baseline)
+    s = error_stats(ours - theirs)
+    lines = [f"| measurement | baseline (mm) | this (mm) | paired difference (95 % CI) | "
+             f"closer for (of {len(ours)}) |", "|---|---|---|---|---|"]
+    for j, (key, (_, label)) in enumerate(MEASUREMENTS.items()):
+        lines.append(f"| {key} {label} | {theirs[:, j].mean():.2f} | {ours[:, j].mean():.2f} | "
+                     f"{s.bias[j]:+.2f} (±{s.bias_ci[j]:.2f}) | "
+                     f"{int((ours[:, j] < theirs[:, j]).sum())} |")
+    diff, diff_ci, _ = paired_difference(run, baseline)
+    ours7, theirs7 = (a[:, IMPORTANT_COLUMNS].mean(axis=1) for a in (ours, theirs))
+    lines.append(f"| mean of {' '.join(IMPORTANT)} | {theirs7.mean():.2f} | {ours7.mean():.2f} | "
+                 f"{diff:+.2f} (±{diff_ci:.2f}) | {int((ours7 < theirs7).sum())} |")
+    return lines
 
 
 def important_table(runs: dict[str, RunScores],

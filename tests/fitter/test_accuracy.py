@@ -249,3 +249,31 @@ def test_paired_difference_is_scipys_paired_t_interval_over_common_subjects():
     assert table[0].endswith("paired difference (95 % CI) |")
     assert table[3].endswith(f"{diff:+.2f} (±{ci:.2f}) from base |")
     assert table[2].endswith("| |")  # the baseline's own row has no difference
+
+
+def test_paired_measurement_table_is_scipys_paired_t_per_measurement():
+    from bodyfit.fitter.accuracy.report import paired_difference, paired_measurement_table
+    from bodyfit.fitter.accuracy.scores import RunScores
+
+    rng = np.random.default_rng(2)
+    base_errors, run_errors = rng.normal(0, 5, (12, 16)), rng.normal(0, 3, (12, 16))
+    ids = [f"s{i:04d}" for i in range(12)]
+
+    def scores(subjects, errors):
+        n = len(subjects)
+        return RunScores(subjects, errors, np.zeros((n, 16)), np.zeros(n), [], np.zeros(n, bool))
+
+    order = rng.permutation(np.arange(2, 12))  # the run holds 10 of the 12, shuffled
+    base, run = scores(ids, base_errors), scores([ids[i] for i in order], run_errors[order])
+    table = paired_measurement_table(run, base)
+    assert table[0].endswith("closer for (of 10) |") and len(table) == 2 + 16 + 1
+    for j, line in enumerate(table[2:18]):
+        a, b = np.abs(run_errors[2:, j]), np.abs(base_errors[2:, j])
+        interval = stats.ttest_rel(a, b).confidence_interval(0.95)
+        cells = [cell.strip() for cell in line.split("|")[1:-1]]
+        assert cells[1:3] == [f"{b.mean():.2f}", f"{a.mean():.2f}"]
+        assert cells[3] == (f"{(interval.low + interval.high) / 2:+.2f} "
+                            f"(±{(interval.high - interval.low) / 2:.2f})")
+        assert cells[4] == str(int((a < b).sum()))
+    diff, ci, _ = paired_difference(run, base)
+    assert table[-1].split("|")[4].strip() == f"{diff:+.2f} (±{ci:.2f})"
