@@ -8,6 +8,7 @@ import pytest
 import scipy.ndimage as ndi
 from scipy.spatial import cKDTree
 
+from bodyfit.kernels.body_layout import PART_NAMES
 from bodyfit.kernels.boundary import nearest_boundary, scan_label_maps, unpack_runs
 from bodyfit.kernels.target import boundary_distance, boundary_mask, prepare_view_target
 
@@ -24,9 +25,9 @@ def blob_maps(num: int, height: int = 96, width: int = 128, seed: int = 0) -> np
             centre = (int(rng.integers(-10, width + 10)), int(rng.integers(-10, height + 10)))
             axes = (int(rng.integers(3, 40)), int(rng.integers(3, 30)))
             cv2.ellipse(m, centre, axes, float(rng.uniform(0, 180)), 0, 360,
-                        int(rng.integers(0, 9)), -1)
+                        int(rng.integers(0, len(PART_NAMES))), -1)
         cv2.line(m, (5, int(rng.integers(0, height))), (width - 5, int(rng.integers(0, height))),
-                 int(rng.integers(0, 9)), 1)
+                 int(rng.integers(0, len(PART_NAMES))), 1)
         m[int(rng.integers(0, height)), int(rng.integers(0, width))] = 3
     return maps
 
@@ -70,7 +71,7 @@ def _check_against_scipy(labels: np.ndarray) -> tuple[float, float]:
         # the part returned is the part of a boundary pixel at exactly that distance
         per_part = np.stack([ndi.distance_transform_edt(boundary != k).ravel()
                              if (boundary == k).any() else np.full(exact.size, np.inf)
-                             for k in range(9)])
+                             for k in range(len(PART_NAMES))])
         assert np.abs(per_part[part, np.arange(part.size)] - exact).max() < 1e-4
     errors = np.concatenate(errors)
     return float(errors.mean()), float(errors.max())
