@@ -75,7 +75,8 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              + ("; for the rows without a sex" if batch else ""))
     parser.add_argument("--weights", metavar="PRESET|FILE.toml",
                         help="cost weights: bodyfit (Table 2 without the top and bottom "
-                             "terms; the default), paper (Table 2; the paper method's), "
+                             "terms, the head and neck 4; the default), paper (Table 2; "
+                             "the paper method's), "
                              "uniform, lower-body, or a .toml file"
                              + ("; for the rows without weights" if batch else ""))
     parser.add_argument("--weight", action="append", metavar="NAME=VALUE",

@@ -36,7 +36,7 @@ def _one_line_error(call, *match):
 
 def test_presets_have_the_documented_values():
     assert PRESETS["paper"] == TABLE_2
-    assert PRESETS["bodyfit"] == {**TABLE_2, "top": 0, "bottom": 0}
+    assert PRESETS["bodyfit"] == {**TABLE_2, "head": 4, "neck": 4, "top": 0, "bottom": 0}
     assert PRESETS["uniform"] == dict.fromkeys(WEIGHT_NAMES, 1.0)
     assert PRESETS["lower-body"] == {
         "head": 1, "chest": 2, "waist": 5, "hip": 8, "leg": 6, "foot": 2, "arm": 1, "elbow": 1,
