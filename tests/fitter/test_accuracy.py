@@ -222,22 +222,26 @@ def test_failures_are_counted_by_reason():
                                      "- 1 x the person is cut off by the frame"]
 
 
+def _scores(subjects: list[str], errors: np.ndarray):
+    """RunScores of ``subjects`` with these (N, 16) errors, nothing else."""
+    from bodyfit.fitter.accuracy.scores import RunScores
+
+    n = len(subjects)
+    return RunScores(subjects, errors, np.zeros((n, 16)), np.zeros(n), [], np.zeros(n, bool))
+
+
 def test_paired_difference_is_scipys_paired_t_interval_over_common_subjects():
     from bodyfit.fitter.accuracy.report import important_table, paired_difference
-    from bodyfit.fitter.accuracy.scores import IMPORTANT_COLUMNS, RunScores
+    from bodyfit.fitter.accuracy.scores import IMPORTANT_COLUMNS
 
     rng = np.random.default_rng(1)
     base_errors, run_errors = rng.normal(0, 5, (30, 16)), rng.normal(1, 5, (30, 16))
     ids = [f"s{i:04d}" for i in range(30)]
 
-    def scores(subjects, errors):
-        n = len(subjects)
-        return RunScores(subjects, errors, np.zeros((n, 16)), np.zeros(n), [], np.zeros(n, bool))
-
     # the run fitted subjects 5..29 only, in another order: pairing must follow the ids
     order = rng.permutation(np.arange(5, 30))
-    base = scores(ids, base_errors)
-    run = scores([ids[i] for i in order], run_errors[order])
+    base = _scores(ids, base_errors)
+    run = _scores([ids[i] for i in order], run_errors[order])
     diff, ci, count = paired_difference(run, base)
     a = np.abs(run_errors[5:, IMPORTANT_COLUMNS]).mean(axis=1)
     b = np.abs(base_errors[5:, IMPORTANT_COLUMNS]).mean(axis=1)
@@ -253,18 +257,13 @@ def test_paired_difference_is_scipys_paired_t_interval_over_common_subjects():
 
 def test_paired_measurement_table_is_scipys_paired_t_per_measurement():
     from bodyfit.fitter.accuracy.report import paired_difference, paired_measurement_table
-    from bodyfit.fitter.accuracy.scores import RunScores
 
     rng = np.random.default_rng(2)
     base_errors, run_errors = rng.normal(0, 5, (12, 16)), rng.normal(0, 3, (12, 16))
     ids = [f"s{i:04d}" for i in range(12)]
 
-    def scores(subjects, errors):
-        n = len(subjects)
-        return RunScores(subjects, errors, np.zeros((n, 16)), np.zeros(n), [], np.zeros(n, bool))
-
     order = rng.permutation(np.arange(2, 12))  # the run holds 10 of the 12, shuffled
-    base, run = scores(ids, base_errors), scores([ids[i] for i in order], run_errors[order])
+    base, run = _scores(ids, base_errors), _scores([ids[i] for i in order], run_errors[order])
     table = paired_measurement_table(run, base)
     assert table[0].endswith("closer for (of 10) |") and len(table) == 2 + 16 + 1
     for j, line in enumerate(table[2:18]):
