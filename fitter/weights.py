@@ -31,13 +31,13 @@ Presets (``PRESETS``):
   and bottom fall in, steps of 4-5 mm weighted by 5 (docs/fitter.md, "Choosing the
   defaults"). The head and neck at 4: on 15 out-of-space subjects the head
   circumference's error fell from 5.8 to 2.6 mm (better for 14), the 7 important
-  measurements' mean by 0.41 mm; in-space (9 subjects) no change shown
+  measurements' mean by 0.41 mm; in-space (11 subjects) no change shown
   (docs/accuracy.md, step 22).
 - ``uniform``: every name 1: the paper's equal-coefficients run of Fig. 17, which it
   shows to be less accurate than Table 2's (Fig. 16).
 - ``lower-body``: for trousers: hip 8, leg 6, waist 5, foot 2, top 5, bottom 5 (the
-  lowest point fixes leg length), chest 2, head 1, neck 1, arm 1, elbow 1, hand 1, view.front 2,
-  view.side 3. A trouser fit is set by the waistband, the seat (hip), the thighs and
+  lowest point fixes leg length), chest 2, head 1, neck 1, arm 1, elbow 1, hand 1,
+  view.front 2, view.side 3. A trouser fit is set by the waistband, the seat (hip), the thighs and
   inseam (leg) and the hem (foot), so those outweigh Table 2's torso; the upper body keeps
   small weights so that it still steers the shape rather than being free to go wrong.
 
