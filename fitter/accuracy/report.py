@@ -84,10 +84,18 @@ def paired_difference(run: RunScores, baseline: RunScores) -> tuple[float, float
     the subjects both fitted: (mean difference, half-width of its 95 % interval (Student
     t), subjects), mm. Pairing removes the subjects' own difficulty from the comparison."""
     ours, theirs = _paired_absolute(run, baseline)
-    important = (ours[:, IMPORTANT_COLUMNS].mean(axis=1)
-                 - theirs[:, IMPORTANT_COLUMNS].mean(axis=1))
-    s = error_stats(important[:, None])
-    return float(s.bias[0]), float(s.bias_ci[0]), len(ours)
+    return (*_mean_with_interval(_important(ours) - _important(theirs)), len(ours))
+
+
+def _important(absolute: np.ndarray) -> np.ndarray:
+    """(S,) each subject's mean |error| over the 7 important measurements of (S, 16)."""
+    return absolute[:, IMPORTANT_COLUMNS].mean(axis=1)
+
+
+def _mean_with_interval(differences: np.ndarray) -> tuple[float, float]:
+    """(mean, half-width of its 95 % Student-t interval) of (S,) paired differences."""
+    s = error_stats(differences[:, None])
+    return float(s.bias[0]), float(s.bias_ci[0])
 
 
 def _paired_absolute(run: RunScores, baseline: RunScores) -> tuple[np.ndarray, np.ndarray]:
@@ -115,8 +123,8 @@ def paired_measurement_table(run: RunScores, baseline: RunScores) -> list[str]:
         lines.append(f"| {key} {label} | {theirs[:, j].mean():.2f} | {ours[:, j].mean():.2f} | "
                      f"{s.bias[j]:+.2f} (±{s.bias_ci[j]:.2f}) | "
                      f"{int((ours[:, j] < theirs[:, j]).sum())} |")
-    diff, diff_ci, _ = paired_difference(run, baseline)
-    ours7, theirs7 = (a[:, IMPORTANT_COLUMNS].mean(axis=1) for a in (ours, theirs))
+    ours7, theirs7 = _important(ours), _important(theirs)
+    diff, diff_ci = _mean_with_interval(ours7 - theirs7)
     lines.append(f"| mean of {' '.join(IMPORTANT)} | {theirs7.mean():.2f} | {ours7.mean():.2f} | "
                  f"{diff:+.2f} (±{diff_ci:.2f}) | {int((ours7 < theirs7).sum())} |")
     return lines
