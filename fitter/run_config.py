@@ -4,7 +4,9 @@ run.json (:func:`bodyfit.fitter.run.run_record`) holds the person's inputs and t
 settings as plain JSON (dataclasses as objects, tuples as lists). :func:`run_config`
 rebuilds them, type-checked field by field against the dataclasses, so that a repeated
 run with the same seed gives the same body. Relative input paths are taken relative to
-the working folder the run was started in (recorded as ``working_dir``).
+the working folder the run was started in (recorded as ``working_dir``). A run.json written
+before the neck was a part of its own (nine part weights) weighs the neck as its head, as
+those runs did.
 """
 
 from __future__ import annotations
@@ -91,6 +93,19 @@ def _build(cls, values, where: str, nested: dict[str, type] | None = None):
         raise UserError(f"{where}: {exc}") from None
 
 
+def _neck_as_head(settings):
+    """run.json's ``settings`` object with a neck weight appended to a cost's part weights
+    written before the neck was a part (one value short; the neck is the last part): the
+    head's, which weighed the neck then. Anything else is returned as it is, for
+    :func:`_build` to check."""
+    cost = settings.get("cost") if isinstance(settings, dict) else None
+    weights = cost.get("part_weights") if isinstance(cost, dict) else None
+    if not (isinstance(weights, list) and len(weights) == len(kernels.PART_NAMES) - 1):
+        return settings
+    neck_as_head = weights + [weights[kernels.PART_NAMES.index("head")]]
+    return {**settings, "cost": {**cost, "part_weights": neck_as_head}}
+
+
 def run_config(record: dict, where: str = "run.json") -> RunConfig:
     """The inputs, settings and output folder of a run.json payload.
 
@@ -103,7 +118,7 @@ def run_config(record: dict, where: str = "run.json") -> RunConfig:
         if key not in record:
             raise UserError(f"{where}: missing {key!r}; is it a fitter run's run.json?")
     inputs = _build(PersonInputs, record["inputs"], f"{where}: inputs")
-    settings = _build(FitSettings, record["settings"], f"{where}: settings",
+    settings = _build(FitSettings, _neck_as_head(record["settings"]), f"{where}: settings",
                       {"search": SearchSettings, "canvas": CanvasSettings,
                        "cost": kernels.CostSettings})
     base, output = record.get("working_dir"), record.get("output")

@@ -11,6 +11,7 @@ import cv2
 import numpy as np
 import pytest
 
+from bodyfit.calib.errors import UserError
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.body_model import PART_NAMES
 from bodyfit.fitter.fit import FitSettings
@@ -113,6 +114,20 @@ def test_run_json_round_trips_into_the_same_settings(first_run):
                                     "settings": dataclasses.asdict(custom)}))
     again = run_config(record)
     assert again.settings == custom and again.inputs == inputs and again.output is None
+
+
+def test_run_json_of_nine_parts_weighs_the_neck_as_its_head(first_run):
+    record = json.loads((first_run / "run.json").read_text())
+    weights = record["settings"]["cost"]["part_weights"][:-1]  # as written before the neck
+    weights[PART_NAMES.index("head")] = 3.0  # unlike any preset's neck
+    record["settings"]["cost"]["part_weights"] = weights
+    old = run_config(record).settings
+    assert old.cost.part_weights == (*weights, 3.0)
+    assert old == dataclasses.replace(read_run_config(first_run / "run.json").settings,
+                                      cost=old.cost)
+    record["settings"]["cost"]["part_weights"] = weights[:-1]
+    with pytest.raises(UserError, match="part_weights needs 10 values"):
+        run_config(record)
 
 
 def test_config_repeats_the_run_and_options_override_it(first_run, tmp_path, capsys):
