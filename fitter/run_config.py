@@ -96,8 +96,9 @@ def _build(cls, values, where: str, nested: dict[str, type] | None = None):
 def _neck_as_head(settings):
     """run.json's ``settings`` object with a neck weight appended to a cost's part weights
     written before the neck was a part (one value short; the neck is the last part): the
-    head's, which weighed the neck then. Anything else is returned as it is, for
-    :func:`_build` to check."""
+    head's, which weighed the neck then (as
+    :func:`bodyfit.fitter.weights.settings_from_record` reads a weights record without a
+    neck). Anything else is returned as it is, for :func:`_build` to check."""
     cost = settings.get("cost") if isinstance(settings, dict) else None
     weights = cost.get("part_weights") if isinstance(cost, dict) else None
     if not (isinstance(weights, list) and len(weights) == len(kernels.PART_NAMES) - 1):

@@ -29,10 +29,10 @@ Presets (``PRESETS``):
   conditioned on the stature (:mod:`bodyfit.fitter.stature`), so every candidate is as
   tall as the person and the two terms measure only which pixel row a silhouette's top
   and bottom fall in, steps of 4-5 mm weighted by 5 (docs/fitter.md, "Choosing the
-  defaults"). The head and neck at 4: on 15 out-of-space subjects the head
-  circumference's error fell from 5.8 to 2.6 mm (better for 14), the 7 important
-  measurements' mean by 0.41 mm; in-space (11 subjects) no change shown
-  (docs/accuracy.md, step 22).
+  defaults"). The head and neck at 4, paired with 2 on 23 out-of-space subjects: the
+  head circumference's error 5.3 -> 2.8 mm (-2.4 +- 1.7, better for 18), the 7 important
+  measurements' mean -0.15 +- 0.57 mm; in-space (19 subjects) no change shown
+  (docs/accuracy.md, steps 22-23).
 - ``uniform``: every name 1: the paper's equal-coefficients run of Fig. 17, which it
   shows to be less accurate than Table 2's (Fig. 16).
 - ``lower-body``: for trousers: hip 8, leg 6, waist 5, foot 2, top 5, bottom 5 (the
