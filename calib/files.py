@@ -21,8 +21,8 @@ from pathlib import Path
 
 from bodyfit.calib.errors import UserError
 
-__all__ = ["TEMP_FILE_PATTERN", "read_json_file", "check_writable_dir", "created_folders",
-           "file_sha256", "write_atomic"]
+__all__ = ["TEMP_FILE_PATTERN", "read_json_file", "check_input_file", "check_writable_dir",
+           "created_folders", "file_sha256", "write_atomic"]
 
 
 def _missing_folders(path: Path) -> list[Path]:
@@ -115,6 +115,21 @@ def file_sha256(path: str | os.PathLike) -> str:
     except OSError as error:
         raise UserError(f"{path}: cannot read it ({error.strerror or error})") from None
     return digest.hexdigest()
+
+
+def check_input_file(path: str | os.PathLike, label: str | None = None) -> None:
+    """Check that a user's input ``path`` is a file.
+
+    Raises:
+        UserError: ``"{label}: no such file"``, or ``"{label}: is a folder, ..."`` naming
+            the files instead (``label`` defaults to the path).
+    """
+    path, label = Path(path), label or str(path)
+    if path.is_dir():
+        raise UserError(f"{label}: is a folder, not a file; name the files in it "
+                        f"(e.g. {path}/*.jpg)")
+    if not path.is_file():
+        raise UserError(f"{label}: no such file")
 
 
 def read_json_file(path: str | os.PathLike, label: str, advice: str = ""):

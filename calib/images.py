@@ -24,7 +24,7 @@ import numpy as np
 
 from bodyfit.calib.blur import edge_rise_px
 from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import write_atomic
+from bodyfit.calib.files import check_input_file, write_atomic
 
 __all__ = [
     "VIDEO_SUFFIXES",
@@ -91,8 +91,7 @@ def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, lis
     truncated, not an image, or declaring more pixels than OpenCV accepts).
     """
     path = Path(path)
-    if not path.is_file():
-        raise UserError(f"{path}: no such file")
+    check_input_file(path)
     try:
         pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), flags)
     except cv2.error:  # e.g. a header claiming a width above CV_IO_MAX_IMAGE_WIDTH
@@ -153,8 +152,7 @@ def sample_video_frames(path: str | Path, max_frames: int) -> Iterator[tuple[int
     if max_frames < 1:
         raise ValueError(f"max_frames must be at least 1, got {max_frames}")
     path = Path(path)
-    if not path.is_file():
-        raise UserError(f"{path}: no such file")
+    check_input_file(path)
     capture = cv2.VideoCapture(str(path))
     try:
         if not capture.isOpened():

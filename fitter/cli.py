@@ -15,6 +15,7 @@ from pathlib import Path
 
 from bodyfit.calib.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import check_input_file
 
 __all__ = ["main"]
 
@@ -411,8 +412,7 @@ def _batch_jobs(args):
         value = options[name]
         if value is None or (name == "weights" and not value.endswith(".toml")):
             continue
-        if not Path(value).is_file():
-            raise UserError(f"--{name.replace('_', '-')} {value}: no such file")
+        check_input_file(value, f"--{name.replace('_', '-')} {value}")
         options[name] = str(Path(value).absolute())
     if options["camera"]:
         load_camera(options["camera"])

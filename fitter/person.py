@@ -15,6 +15,7 @@ import numpy as np
 
 from bodyfit.calib.camera import load_camera
 from bodyfit.calib.errors import UserError
+from bodyfit.calib.files import check_input_file
 from bodyfit.calib.images import read_photo
 from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
 from bodyfit.fitter.pinhole_canvas import phone_intrinsics, upright_intrinsics
@@ -59,8 +60,8 @@ class PersonInputs:
             raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
         for path in (self.front, self.side, self.camera, self.mask_front, self.mask_side,
                      self.background_front, self.background_side):
-            if path is not None and not Path(path).is_file():
-                raise UserError(f"{path}: no such file")
+            if path is not None:
+                check_input_file(path)
 
 
 def _view_mask(photo: str, mask: str | None, background: str | None, camera) -> np.ndarray:

@@ -200,6 +200,7 @@ def bad_inputs(tmp_path, chessboard_shots):
         ),
         "view": chessboard_shots.sharp[0],
         "view2": chessboard_shots.sharp[1],
+        "folder": tmp_path,
     }
     inputs["junk"].write_bytes(b"\xff\xd8 this is not a JPEG")
     inputs["corrupt_camera"].write_text('{"image_size_px": [1280, 720], "K": [[1050, 0, 648')
@@ -215,6 +216,7 @@ BAD_INPUT_CASES = {
     "photos of different sizes": (["capture", "view", "small", *CHESSBOARD, "-o", OUT], "must all have one size"),
     "unreadable file": (["capture", "view", "junk", *CHESSBOARD, "-o", OUT], "not a readable image"),
     "missing file": (["capture", "view", "nowhere.png", *CHESSBOARD, "-o", OUT], "no such file"),
+    "a folder for a photo": (["capture", "view", "folder", *CHESSBOARD, "-o", OUT], "is a folder, not a file"),
     "missing square size": (["capture", "view", "--board", "chessboard:9x6", "-o", OUT], "--square-mm"),
     "bad board": (["capture", "view", "--board", "chess:9", "--square-mm", "25", "-o", OUT], "KIND:COLSxROWS"),
     "corrupt camera.json (undistort)": (["undistort", "corrupt_camera", "view", "-o", "DIR"], "not valid JSON"),

@@ -172,6 +172,7 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--height-cm": "1.80"}, "centimetres"),
     ({"--height-cm": "400"}, "centimetres"),
     ({"--front": "missing.png"}, "no such file"),
+    ({"--side": "."}, "is a folder, not a file"),
     ({"--weight": "knee=3"}, "unknown"),
     ({"--weight": "waist"}, "NAME=VALUE|="),
     ({"--weights": "heavy"}, "heavy"),
