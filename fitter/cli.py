@@ -116,7 +116,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="each refinement's generations (default 500)")
     parser.add_argument("--refinements", type=int,
                         help="refinements (seeds SEED, SEED+1, ...) whose answers are averaged "
-                             "(default 4)")
+                             "(default 6)")
     parser.add_argument("--free-stature", action="store_true", default=None,
                         help="search the first shape component like the others (the paper) "
                              "instead of solving it so every candidate stands as tall as the "

@@ -77,7 +77,9 @@ class SearchSettings:
             body the silhouettes fix, each by about its error (the cost is flat across
             millimetres of shape), so their mean is nearer: four against two, -0.42 mm
             in-space and -0.40 out-of-space on the first 40 subjects of each set
-            (docs/accuracy.md, step 16).
+            (docs/accuracy.md, step 16); six against four, -0.17 +- 0.12 mm over 44
+            subjects of both sets, each subject's own fits, for 1.43x the candidates
+            (steps 20, 23-24).
     """
 
     optimizer: str = "cmaes"
@@ -93,7 +95,7 @@ class SearchSettings:
     searches: int = 2
     refine_components: int = 40
     refine_generations: int = 500
-    refinements: int = 4
+    refinements: int = 6
 
     def validate(self, stored_components: int) -> None:
         if self.optimizer not in OPTIMIZER_NAMES:

@@ -8,6 +8,7 @@ import pytest
 
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.run import RUN_FILES
+from bodyfit.fitter.search import SearchSettings
 from bodyfit.fitter.studio_photos import write_subject
 
 TRUE_BETAS = np.array([0.8, -0.6, 0.5, 0.3, -0.4] + [0.0] * 15)
@@ -115,9 +116,10 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
                                                                      capsys):
     """--refine-components 24: the searches run as without it (their curves and
     per-generation answers the same, the answers padded with zero components), then the
-    refinements' generations follow, four refinements by default (one with
-    --refinements 1); the answer has 24 components, scored at its cost."""
+    refinements' generations follow, ``SearchSettings.refinements`` of them by default (one
+    with --refinements 1); the answer has 24 components, scored at its cost."""
     folder, truth = subject
+    n = SearchSettings().refinements
     budget = ["--population", "8", "--generations", "4", "--seed", "4"]
     refine = ["--refine-components", "24", "--refine-generations", "3"]
     results = {}
@@ -129,28 +131,29 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
         results[name] = json.loads((tmp_path / name / "run.json").read_text())["result"]
     searches, refined = results["searches"], results["refined"]
     assert len(refined["betas"]) == 24 and len(searches["betas"]) == 20
-    assert refined["evaluations"] == 2 * 8 * 4 + 4 * 8 * 3 and refined["generations"] == 7
+    assert refined["evaluations"] == 2 * 8 * 4 + n * 8 * 3 and refined["generations"] == 7
     assert results["one"]["evaluations"] == 2 * 8 * 4 + 8 * 3
     assert refined["best_cost_per_generation"][:4] == searches["best_cost_per_generation"]
     answers = np.array(refined["best_betas_per_generation"])
     np.testing.assert_allclose(answers[:4, :20], searches["best_betas_per_generation"])
     assert not answers[:4, 20:].any() and answers[4:, 20:].any()
     assert not np.allclose(refined["betas"], results["one"]["betas"])
-    # run.json holds the answers averaged: the four refinements' (run side by side; the
+    # run.json holds the answers averaged: the n refinements' (run side by side; the
     # first equals the refinement of the same seed run alone), the two searches' without
     # refinements, none for one refinement
-    four = refined["averaged"]
-    assert len(four) == 4 and len(searches["averaged"]) == 2 and results["one"]["averaged"] == []
-    assert four[0]["betas"] == results["one"]["betas"]
-    np.testing.assert_allclose(np.mean([a["betas"] for a in four], axis=0)[1:],
+    averaged = refined["averaged"]
+    assert len(averaged) == n and len(searches["averaged"]) == 2
+    assert results["one"]["averaged"] == []
+    assert averaged[0]["betas"] == results["one"]["betas"]
+    np.testing.assert_allclose(np.mean([a["betas"] for a in averaged], axis=0)[1:],
                                refined["betas"][1:], atol=1e-9)
     for joint, angle in refined["pose_deg"].items():
-        assert angle == pytest.approx(np.mean([a["pose_deg"][joint] for a in four]))
-    assert all(a["cost"] > 0 for a in four)
+        assert angle == pytest.approx(np.mean([a["pose_deg"][joint] for a in averaged]))
+    assert all(a["cost"] > 0 for a in averaged)
     assert sum(refined["part_costs"].values()) == pytest.approx(refined["best_cost"],
                                                                 rel=1e-5)
-    assert "24 components, 3 generations, 4 averaged" in (tmp_path / "refined"
-                                                          / "report.html").read_text()
+    assert f"24 components, 3 generations, {n} averaged" in (tmp_path / "refined"
+                                                             / "report.html").read_text()
 
 
 def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
