@@ -48,7 +48,9 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import csv
 import dataclasses
+import io
 import json
 import multiprocessing
 import os
@@ -83,6 +85,7 @@ from bodyfit.fitter.canvas import extreme_bodies
 from bodyfit.fitter.fit import stature_conditioner
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
+from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import read_run_config, run_config
 from bodyfit.fitter.stature import scaled_to_stature
@@ -130,6 +133,34 @@ def _table_rows(folder: Path, first: int, keepends: bool = False, skip: int = 0)
     return lines[:1] + lines[1 + skip:first + 1]
 
 
+def _read_table(path: Path) -> tuple[list[str], list[dict[str, str]]]:
+    """A CSV table's header and rows (none when there is no file)."""
+    if not path.exists():
+        return [], []
+    with open(path, newline="", encoding="utf-8") as stream:
+        reader = csv.DictReader(stream)
+        return list(reader.fieldnames or ()), list(reader)
+
+
+def _keep_earlier_rows(out: Path, earlier: dict[str, list[dict[str, str]]]) -> None:
+    """Put back into the run's summary.csv and failures.csv the rows ``earlier`` (file name
+    -> its rows before this batch) held of subjects outside this batch's table: fitter
+    batch writes its tables for its own table's rows, so a run fitted in parts (``fit
+    --skip``) would otherwise describe its last part alone. Rows in the set's order (ids
+    sort as rows)."""
+    now = {row["id"] for row in _read_table(out / SUMMARY_FILE)[1]}
+    for name in (FAILURES_FILE, SUMMARY_FILE):  # failures first, as fitter batch writes them
+        header, rows = _read_table(out / name)
+        others = [row for row in earlier[name] if row["id"] not in now]
+        if not others:
+            continue
+        buffer = io.StringIO()
+        writer = csv.DictWriter(buffer, header, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(sorted(rows + others, key=lambda row: row["id"]))
+        write_text(out / name, buffer.getvalue())
+
+
 def fit(args, batch_options: list[str]) -> None:
     folder = Path(args.set)
     if not (folder / "subjects.csv").exists():
@@ -151,9 +182,11 @@ def fit(args, batch_options: list[str]) -> None:
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
                *(["--camera", str(camera)] if args.camera == "calibrated" else []),
                *batch_options]
+    earlier = {name: _read_table(out / name)[1] for name in (SUMMARY_FILE, FAILURES_FILE)}
     start = time.perf_counter()
     code = subprocess.run(command).returncode
     wall = time.perf_counter() - start
+    _keep_earlier_rows(out, earlier)
     if code not in (0, 1):  # 1: some subjects failed (recorded in failures.csv)
         sys.exit(f"fitter batch stopped with exit status {code}")
     record = {"command": command, "wall_s": round(wall, 1),
@@ -651,7 +684,8 @@ def main() -> None:
                    "half women, half men)")
     p.add_argument("--skip", type=int, default=0, metavar="I",
                    help="with --first N: leave out the first I subjects (fitted by another "
-                   "run, e.g. in an earlier session), fit rows I to N - 1")
+                   "run, e.g. in an earlier session), fit rows I to N - 1; the run's summary.csv "
+                   "keeps the rows it had of other subjects")
     p = sub.add_parser("keep", help="copy a run's tables out of its set, to commit them")
     p.add_argument("set")
     p.add_argument("name", help="the run's name (SET/runs/NAME)")

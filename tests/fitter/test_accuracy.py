@@ -204,10 +204,17 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
                     printed)
     assert float(row[2]) < float(row[1]) and row[3] == "2"
     # the rest of a set: rows 2-3 only (all fitted already in this run: it resumes, fits none)
+    summary = subject_set / "runs" / "small" / "summary.csv"
+    before = summary.read_text().splitlines()
     tool("fit", str(subject_set), "small", "--first", "4", "--skip", "2")
     rows = (subject_set / "subjects-rows2-3.csv").read_text().splitlines()
     assert rows[0] == (subject_set / "subjects.csv").read_text().splitlines()[0]
     assert [row.split(",")[0] for row in rows[1:]] == [line.split(",")[0] for line in lines[3:]]
+    # ... and the run's summary still holds rows 0-1 as they were, rows 2-3 fitted earlier
+    after = summary.read_text().splitlines()
+    assert after[:3] == before[:3] and len(after) == 5
+    assert [line.split(",")[:2] for line in after[3:]] == [
+        [line.split(",")[0], "fitted earlier"] for line in before[3:]]
 
 
 def test_failures_are_counted_by_reason():
