@@ -59,7 +59,7 @@ import dataclasses
 import numpy as np
 
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
-from bodyfit.fitter.sections import mesh_edges, region_edges, tape_lengths
+from bodyfit.fitter.sections import mesh_edges, region_edges, section_points, tape_lengths
 
 __all__ = ["MEASUREMENTS", "IMPORTANT", "Measurer"]
 
@@ -177,6 +177,21 @@ class Measurer:
         origins[:, 2] = heights
         return tape_lengths(vertices, self._edges[region], origins, _UP)
 
+    def _neck_plane(self, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(1, 3) the neck circumference's point, (3,) its normal: midway between the
+        neck's base and top rings, perpendicular to the line joining them."""
+        base, top = self._ring(vertices, "neck_base"), self._ring(vertices, "neck_top")
+        return 0.5 * (base + top)[None], top - base
+
+    def neck_section(self, vertices: np.ndarray) -> np.ndarray:
+        """(n, 2) float64, metres: the points where the neck circumference's plane cuts
+        the neck (whose convex hull is the tape), across the body (the model's x, as a front
+        photo shows the neck) then front to back (as a side photo does); ``vertices``:
+        (V, 3) metres, rest A-pose."""
+        v = np.asarray(vertices, np.float64)
+        origin, normal = self._neck_plane(v)
+        return section_points(v, self._edges["neck"], origin[0], normal, np.array([1.0, 0, 0]))
+
     def measure(self, vertices: np.ndarray) -> dict[str, float]:
         """The 16 measurements of one body.
 
@@ -198,9 +213,7 @@ class Measurer:
         span = top - neck_top[2]
         out["A"] = np.nanmax(self._horizontal_girth(
             v, "skull", neck_top[2] + span * np.linspace(0.5, 0.8, 7)))
-        base = self._ring(v, "neck_base")
-        out["B"] = tape_lengths(v, self._edges["neck"], [0.5 * (base + neck_top)],
-                                neck_top - base)[0]
+        out["B"] = tape_lengths(v, self._edges["neck"], *self._neck_plane(v))[0]
         out["C"] = acromion[:, 2].mean() - crotch[2]
         out["D"] = self._horizontal_girth(v, "trunk", self._point(v, "bust")[:, 2].mean())[0]
         out["E"] = self._horizontal_girth(v, "trunk", self._point(v, "navel")[0, 2])[0]

@@ -14,7 +14,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-__all__ = ["mesh_edges", "region_edges", "plane_basis", "tape_lengths"]
+__all__ = ["mesh_edges", "region_edges", "plane_basis", "hull_perimeter", "tape_lengths",
+           "section_points"]
 
 
 def mesh_edges(faces: np.ndarray) -> np.ndarray:
@@ -69,6 +70,11 @@ def _sections(vertices: np.ndarray, edges: np.ndarray, origins: np.ndarray,
     return out
 
 
+def hull_perimeter(points: np.ndarray) -> float:
+    """The perimeter of the 2D convex hull of ``points`` (n >= 3, 2), in their unit."""
+    return cv2.arcLength(cv2.convexHull(np.asarray(points, np.float32)), closed=True)
+
+
 def tape_lengths(vertices: np.ndarray, edges: np.ndarray, origins: np.ndarray,
                  normal: np.ndarray) -> np.ndarray:
     """Convex-hull perimeter of the sections of parallel planes.
@@ -86,5 +92,29 @@ def tape_lengths(vertices: np.ndarray, edges: np.ndarray, origins: np.ndarray,
     out = np.full(len(origins), np.nan)
     for i, pts in enumerate(_sections(vertices, edges, origins, normal)):
         if len(pts) >= 3:
-            out[i] = cv2.arcLength(cv2.convexHull(pts.astype(np.float32)), closed=True)
+            out[i] = hull_perimeter(pts)
     return out
+
+
+def section_points(vertices: np.ndarray, edges: np.ndarray, origin: np.ndarray,
+                   normal: np.ndarray, across: np.ndarray) -> np.ndarray:
+    """Where one plane cuts the ``edges`` (E, 2) of a mesh with ``vertices`` (V, 3), in a
+    frame of the plane turned to a direction of the body.
+
+    Args:
+        origin: (3,) a point of the plane; normal: (3,) its normal (any length > 0).
+        across: (3,) a direction not along ``normal``: the frame's first axis is it
+            projected onto the plane, the second ``normal`` x the first (for a neck, the
+            model's x gives its width as a front photo shows it, then its depth as a side
+            photo does).
+
+    Returns:
+        (n, 2) float64, metres, relative to the plane's point nearest the model's origin.
+    """
+    n = np.asarray(normal, np.float64)
+    n = n / np.linalg.norm(n)
+    first = np.asarray(across, np.float64) - np.dot(across, n) * n
+    first /= np.linalg.norm(first)
+    frame = np.stack([first, np.cross(n, first)])
+    points = _sections(vertices, edges, np.atleast_2d(np.asarray(origin, np.float64)), n)[0]
+    return points @ plane_basis(n) @ frame.T

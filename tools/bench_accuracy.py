@@ -85,6 +85,7 @@ from bodyfit.fitter.canvas import extreme_bodies
 from bodyfit.fitter.fit import stature_conditioner
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
+from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import read_run_config, run_config
@@ -444,6 +445,9 @@ def combine(args) -> None:
     measurer = Measurer.from_model(model)
     errors, counts = {}, set()
     scatter, round_trip, rebuilt = [], 0.0, 0
+    truths = read_bodies(model, folder)
+    ids = subject_ids(len(truths.sex), truths.sex)
+    necks = []  # (truth's neck section, the fit's, the canvas's mm per pixel) per subject
     subjects = [row.split(",")[0] for row in
                 (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]]
     holder = {subject: run for run, own in _joined(
@@ -495,6 +499,9 @@ def combine(args) -> None:
             round_trip = max(round_trip, float(np.abs(own - measured[0]).max()))
             rebuilt += 1
         scatter.append(measured[len(rules):].std(axis=0, ddof=1))  # the single answers'
+        necks.append((measurer.neck_section(truths.vertices[ids.index(subject)]),
+                      measurer.neck_section(rest[0]),
+                      1000 * stature_m / settings.canvas.body_height_px))
     fit = np.array(errors.get(FIT_RULE, []))
     count = len(fit)
     if count < 2:
@@ -515,6 +522,34 @@ def combine(args) -> None:
     within = np.mean(np.abs(fit) <= np.array(scatter), axis=0)
     print("\nThe truth within the single answers' scatter (1 sd), per measurement: "
           + ", ".join(f"{key} {share:.0%}" for key, share in zip(KEYS, within)))
+    print("\n" + _neck_line(necks))
+
+
+def _neck_line(necks: list[tuple[np.ndarray, np.ndarray, float]]) -> str:
+    """Where the fit's neck circumference goes wrong: its section's width (across, what a
+    front photo shows) and depth (front to back, a side photo's) against the truth's, and
+    the circumference's error left when one section is scaled to the other's width and
+    depth (what the section's shape alone gives) or the truth's to the fit's (what the
+    extents alone give). ``necks``: (truth's section, fit's section, canvas mm per pixel)
+    per subject, sections (n, 2) metres (``Measurer.neck_section``)."""
+    rows = []
+    for truth, fitted, pixel_mm in necks:
+        true_size, fit_size = np.ptp(truth, axis=0), np.ptp(fitted, axis=0)
+        tape = hull_perimeter(truth)
+        rows.append([hull_perimeter(fitted) - tape, *(1000 * (fit_size - true_size)),
+                     hull_perimeter(fitted * true_size / fit_size) - tape,
+                     hull_perimeter(truth * fit_size / true_size) - tape, pixel_mm])
+    e = np.array(rows)
+    e[:, [0, 3, 4]] *= 1000
+    mean = np.abs(e[:, :5]).mean(axis=0)
+    r = [np.corrcoef(e[:, 0], e[:, j])[0, 1] for j in (1, 2)]
+    return (f"The neck (B), the fit's section against the truth's, {len(e)} subjects, mean "
+            f"|error|: circumference {mean[0]:.2f} mm; width {mean[1]:.2f} mm "
+            f"({np.mean(np.abs(e[:, 1]) / e[:, 5]):.2f} canvas px), depth {mean[2]:.2f} mm "
+            f"({np.mean(np.abs(e[:, 2]) / e[:, 5]):.2f} px); the circumference's error "
+            f"correlates {r[0]:.2f} with the width's, {r[1]:.2f} with the depth's; the fit's "
+            f"section at the truth's width and depth (its shape's part) {mean[3]:.2f} mm, the "
+            f"truth's at the fit's width and depth (the extents' part) {mean[4]:.2f} mm")
 
 
 def _run_folder(set_folder: Path, name: str) -> Path:

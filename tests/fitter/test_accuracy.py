@@ -189,6 +189,12 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert float(re.search(r"rebuilt to within ([.\d]+) mm", printed)[1]) < 0.02
     assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) .* \| \+0\.00 ± 0\.00 \|",
                      printed)[1] == f"{mean7:.2f}"
+    # the neck's section in the fit's body against the truth's: its circumference is the
+    # neck measurement's (a round trip against the report's table, one decimal there)
+    neck = re.search(r"mean \|error\|: circumference ([.\d]+) mm; width ([.\d]+) mm", printed)
+    reported = next(line for line in report.splitlines() if line.startswith("| B neck"))
+    assert float(neck[1]) == pytest.approx(float(reported.split("|")[2].split("±")[0]), abs=0.051)
+    assert float(neck[2]) > 0
     # each fit's first three answers only: as the mean of the first three of all four
     first3 = re.search(r"\| the mean of the first 3 \| ([.\d]+) ", printed)[1]
     # the kept records combine as the run's own (a round trip through `keep`)

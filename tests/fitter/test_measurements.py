@@ -8,7 +8,7 @@ from scipy.spatial import ConvexHull
 from bodyfit.fitter.anny_source import SHAPE_PARAMETERS
 from bodyfit.fitter.measurements import MEASUREMENTS
 from bodyfit.fitter.population_sampler import SEXES, ReferenceStats
-from bodyfit.fitter.sections import mesh_edges, tape_lengths
+from bodyfit.fitter.sections import hull_perimeter, mesh_edges, section_points, tape_lengths
 
 KEYS = list(MEASUREMENTS)
 
@@ -32,6 +32,20 @@ def test_tilted_plane_through_a_cylinder_is_an_ellipse():
     normal = [np.sin(tilt), 0.0, np.cos(tilt)]
     got = tape_lengths(cyl.vertices, mesh_edges(cyl.faces), [[0, 0, 0]], normal)[0]
     assert got == pytest.approx(ellipse_perimeter(0.05 / np.cos(tilt), 0.05), rel=2e-5)
+
+
+def test_section_of_a_tilted_plane_is_turned_across_the_body():
+    """A plane tilted forward about the x axis cuts an elliptic cylinder (semi-axes 8 cm
+    across, 5 cm front to back) in an ellipse 16 cm across and 10 / cos(tilt) cm deep."""
+    cyl = trimesh.creation.cylinder(radius=1.0, height=2.0, sections=720)
+    vertices = cyl.vertices * [0.08, 0.05, 1.0]
+    tilt = np.deg2rad(25)
+    points = section_points(vertices, mesh_edges(cyl.faces), [0.0, 0.0, 0.3],
+                            [0.0, np.sin(tilt), np.cos(tilt)], [1.0, 0.0, 0.0])
+    assert np.ptp(points[:, 0]) == pytest.approx(0.16, rel=1e-5)
+    assert np.ptp(points[:, 1]) == pytest.approx(0.10 / np.cos(tilt), rel=1e-5)
+    assert hull_perimeter(points) == pytest.approx(
+        ellipse_perimeter(0.08, 0.05 / np.cos(tilt)), rel=2e-5)
 
 
 def test_tape_bridges_concavities_of_an_l_shaped_prism():
@@ -76,6 +90,17 @@ def test_stature_is_the_mesh_height_and_translation_does_not_matter(body_model, 
     shifted = measurer.measure(v + [0.5, -2.0, 1.3])
     for key in KEYS:
         assert shifted[key] == pytest.approx(got[key], abs=1e-3), key
+
+
+def test_neck_section_is_the_neck_tape(measurer, body_model):
+    """The neck section's hull is the neck circumference (B); a body twice as wide has a
+    section twice as wide and as deep as before."""
+    v = body_model.mean_vertices.astype(np.float64)
+    points = measurer.neck_section(v)
+    assert hull_perimeter(points) * 1000 == pytest.approx(measurer.measure(v)["B"], rel=1e-6)
+    wide = measurer.neck_section(v * [2.0, 1.0, 1.0])
+    assert np.ptp(wide[:, 0]) == pytest.approx(2 * np.ptp(points[:, 0]), rel=1e-5)
+    assert np.ptp(wide[:, 1]) == pytest.approx(np.ptp(points[:, 1]), rel=1e-5)
 
 
 def test_all_measurements_are_plausible_on_the_mean_body(measurer, body_model):
