@@ -177,7 +177,7 @@ class Measurer:
         origins[:, 2] = heights
         return tape_lengths(vertices, self._edges[region], origins, _UP)
 
-    def _neck_plane(self, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def neck_plane(self, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(1, 3) the neck circumference's point, (3,) its normal: midway between the
         neck's base and top rings, perpendicular to the line joining them."""
         base, top = self._ring(vertices, "neck_base"), self._ring(vertices, "neck_top")
@@ -189,7 +189,7 @@ class Measurer:
         photo shows the neck) then front to back (as a side photo does); ``vertices``:
         (V, 3) metres, rest A-pose."""
         v = np.asarray(vertices, np.float64)
-        origin, normal = self._neck_plane(v)
+        origin, normal = self.neck_plane(v)
         return section_points(v, self._edges["neck"], origin[0], normal, np.array([1.0, 0, 0]))
 
     def measure(self, vertices: np.ndarray) -> dict[str, float]:
@@ -213,7 +213,7 @@ class Measurer:
         span = top - neck_top[2]
         out["A"] = np.nanmax(self._horizontal_girth(
             v, "skull", neck_top[2] + span * np.linspace(0.5, 0.8, 7)))
-        out["B"] = tape_lengths(v, self._edges["neck"], *self._neck_plane(v))[0]
+        out["B"] = tape_lengths(v, self._edges["neck"], *self.neck_plane(v))[0]
         out["C"] = acromion[:, 2].mean() - crotch[2]
         out["D"] = self._horizontal_girth(v, "trunk", self._point(v, "bust")[:, 2].mean())[0]
         out["E"] = self._horizontal_girth(v, "trunk", self._point(v, "navel")[0, 2])[0]

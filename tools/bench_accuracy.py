@@ -499,9 +499,10 @@ def combine(args) -> None:
             round_trip = max(round_trip, float(np.abs(own - measured[0]).max()))
             rebuilt += 1
         scatter.append(measured[len(rules):].std(axis=0, ddof=1))  # the single answers'
-        necks.append((measurer.neck_section(truths.vertices[ids.index(subject)]),
-                      measurer.neck_section(rest[0]),
-                      1000 * stature_m / settings.canvas.body_height_px))
+        true_body = truths.vertices[ids.index(subject)]
+        necks.append((measurer.neck_section(true_body), measurer.neck_section(rest[0]),
+                      1000 * stature_m / settings.canvas.body_height_px,
+                      _beyond_the_neck(measurer, true_body)))
     fit = np.array(errors.get(FIT_RULE, []))
     count = len(fit)
     if count < 2:
@@ -525,15 +526,28 @@ def combine(args) -> None:
     print("\n" + _neck_line(necks))
 
 
-def _neck_line(necks: list[tuple[np.ndarray, np.ndarray, float]]) -> str:
+def _beyond_the_neck(measurer: Measurer, vertices: np.ndarray) -> np.ndarray:
+    """(2,) mm: how much wider (x) and deeper (y) than the neck's section the body
+    ``vertices`` (V, 3, rest) is at the height of the neck tape's centre, within 12 cm of
+    it across (no arm): what of the front and side outlines there is another part (the
+    jaw, the chin) than the neck."""
+    v = np.asarray(vertices, np.float64)
+    centre = measurer.neck_plane(v)[0][0]
+    near = (np.abs(v[:, 2] - centre[2]) < 0.003) & (np.abs(v[:, 0] - centre[0]) < 0.12)
+    return 1000 * (np.ptp(v[near, :2], axis=0) - np.ptp(measurer.neck_section(v), axis=0))
+
+
+def _neck_line(necks: list[tuple[np.ndarray, np.ndarray, float, np.ndarray]]) -> str:
     """Where the fit's neck circumference goes wrong: its section's width (across, what a
     front photo shows) and depth (front to back, a side photo's) against the truth's, and
     the circumference's error left when one section is scaled to the other's width and
     depth (what the section's shape alone gives) or the truth's to the fit's (what the
-    extents alone give). ``necks``: (truth's section, fit's section, canvas mm per pixel)
-    per subject, sections (n, 2) metres (``Measurer.neck_section``)."""
+    extents alone give); and on how many the truth's outlines show the neck at the tape's
+    centre height (:func:`_beyond_the_neck` under 1 mm). ``necks``: (truth's section,
+    fit's section, canvas mm per pixel, :func:`_beyond_the_neck` of the truth) per
+    subject, sections (n, 2) metres (``Measurer.neck_section``)."""
     rows = []
-    for truth, fitted, pixel_mm in necks:
+    for truth, fitted, pixel_mm, _ in necks:
         true_size, fit_size = np.ptp(truth, axis=0), np.ptp(fitted, axis=0)
         tape = hull_perimeter(truth)
         rows.append([hull_perimeter(fitted) - tape, *(1000 * (fit_size - true_size)),
@@ -543,13 +557,18 @@ def _neck_line(necks: list[tuple[np.ndarray, np.ndarray, float]]) -> str:
     e[:, [0, 3, 4]] *= 1000
     mean = np.abs(e[:, :5]).mean(axis=0)
     r = [np.corrcoef(e[:, 0], e[:, j])[0, 1] for j in (1, 2)]
+    beyond = np.array([neck[3] for neck in necks])
     return (f"The neck (B), the fit's section against the truth's, {len(e)} subjects, mean "
             f"|error|: circumference {mean[0]:.2f} mm; width {mean[1]:.2f} mm "
             f"({np.mean(np.abs(e[:, 1]) / e[:, 5]):.2f} canvas px), depth {mean[2]:.2f} mm "
             f"({np.mean(np.abs(e[:, 2]) / e[:, 5]):.2f} px); the circumference's error "
             f"correlates {r[0]:.2f} with the width's, {r[1]:.2f} with the depth's; the fit's "
             f"section at the truth's width and depth (its shape's part) {mean[3]:.2f} mm, the "
-            f"truth's at the fit's width and depth (the extents' part) {mean[4]:.2f} mm")
+            f"truth's at the fit's width and depth (the extents' part) {mean[4]:.2f} mm. At "
+            f"the tape's centre height the truth's outline is the neck's across on "
+            f"{np.sum(beyond[:, 0] < 1)} of {len(e)} (median {np.median(beyond[:, 0]):.1f} mm "
+            f"wider), front to back on {np.sum(beyond[:, 1] < 1)} (median "
+            f"{np.median(beyond[:, 1]):.1f} mm deeper: the chin, the jaw)")
 
 
 def _run_folder(set_folder: Path, name: str) -> Path:
