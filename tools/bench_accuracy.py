@@ -20,7 +20,8 @@
         --main "in-space=SETS/in:docs/accuracy-runs/in-space/default+default-b"
     # how far calib's extracted outlines lie from the exact silhouettes, per refinement passes
     python tools/bench_accuracy.py outlines SETS/in --first 10 --passes 1 2 4
-    # other ways to combine the refinements' answers a run's fits averaged (run.json)
+    # other ways to combine the refinements' answers a run's fits averaged (run.json);
+    # last, where the fits' neck circumference goes wrong (its section's width and depth)
     python tools/bench_accuracy.py combine SETS/in default
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
@@ -85,10 +86,10 @@ from bodyfit.fitter.canvas import extreme_bodies
 from bodyfit.fitter.fit import stature_conditioner
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
-from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import read_run_config, run_config
+from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
@@ -439,7 +440,8 @@ def combine(args) -> None:
     `keep`; several runs are joined, each subject from the first run holding it;
     ``--answers N`` takes each fit's first N answers only (what ``--refinements N``
     gives: the refinements do not depend on their count), so runs of more refinements
-    join runs of N as N's fits."""
+    join runs of N as N's fits. Last, where the fits' neck circumference goes wrong
+    (:func:`_neck_line`)."""
     folder = Path(args.set)
     model = load_model()
     measurer = Measurer.from_model(model)
@@ -447,7 +449,7 @@ def combine(args) -> None:
     scatter, round_trip, rebuilt = [], 0.0, 0
     truths = read_bodies(model, folder)
     ids = subject_ids(len(truths.sex), truths.sex)
-    necks = []  # (truth's neck section, the fit's, the canvas's mm per pixel) per subject
+    necks = []  # per subject, what _neck_line reads
     subjects = [row.split(",")[0] for row in
                 (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]]
     holder = {subject: run for run, own in _joined(
