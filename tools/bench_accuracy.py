@@ -49,9 +49,7 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
-import csv
 import dataclasses
-import io
 import json
 import multiprocessing
 import os
@@ -76,7 +74,8 @@ from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean
 from bodyfit.fitter.accuracy.scores import (IMPORTANT_COLUMNS, KEYS, TRUTHS_FILE, RunScores,
                                             error_stats, read_scores, truth_records)
 from bodyfit.fitter.batch.orchestration import BATCH_FILE
-from bodyfit.fitter.batch.tables import FAILURES_FILE, SUMMARY_FILE
+from bodyfit.fitter.batch.tables import (FAILURES_COLUMNS, FAILURES_FILE, SUMMARY_COLUMNS,
+                                         SUMMARY_FILE, csv_text, read_table)
 from bodyfit.fitter.accuracy.truth_costs import compare_costs
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
                                                  read_settings, read_truth, subject_ids,
@@ -135,32 +134,21 @@ def _table_rows(folder: Path, first: int, keepends: bool = False, skip: int = 0)
     return lines[:1] + lines[1 + skip:first + 1]
 
 
-def _read_table(path: Path) -> tuple[list[str], list[dict[str, str]]]:
-    """A CSV table's header and rows (none when there is no file)."""
-    if not path.exists():
-        return [], []
-    with open(path, newline="", encoding="utf-8") as stream:
-        reader = csv.DictReader(stream)
-        return list(reader.fieldnames or ()), list(reader)
-
-
 def _keep_earlier_rows(out: Path, earlier: dict[str, list[dict[str, str]]]) -> None:
     """Put back into the run's summary.csv and failures.csv the rows ``earlier`` (file name
     -> its rows before this batch) held of subjects outside this batch's table: fitter
     batch writes its tables for its own table's rows, so a run fitted in parts (``fit
     --skip``) would otherwise describe its last part alone. Rows in the set's order (ids
     sort as rows)."""
-    now = {row["id"] for row in _read_table(out / SUMMARY_FILE)[1]}
-    for name in (FAILURES_FILE, SUMMARY_FILE):  # failures first, as fitter batch writes them
-        header, rows = _read_table(out / name)
+    now = {row["id"] for row in read_table(out / SUMMARY_FILE, ("id",))}
+    # failures first, as fitter batch writes them
+    for name, header in ((FAILURES_FILE, FAILURES_COLUMNS), (SUMMARY_FILE, SUMMARY_COLUMNS)):
         others = [row for row in earlier[name] if row["id"] not in now]
         if not others:
             continue
-        buffer = io.StringIO()
-        writer = csv.DictWriter(buffer, header, lineterminator="\n")
-        writer.writeheader()
-        writer.writerows(sorted(rows + others, key=lambda row: row["id"]))
-        write_text(out / name, buffer.getvalue())
+        rows = sorted(read_table(out / name, ("id",)) + others, key=lambda row: row["id"])
+        write_text(out / name, csv_text(header, [[row.get(c, "") for c in header]
+                                                 for row in rows]))
 
 
 def fit(args, batch_options: list[str]) -> None:
@@ -184,7 +172,7 @@ def fit(args, batch_options: list[str]) -> None:
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
                *(["--camera", str(camera)] if args.camera == "calibrated" else []),
                *batch_options]
-    earlier = {name: _read_table(out / name)[1] for name in (SUMMARY_FILE, FAILURES_FILE)}
+    earlier = {name: read_table(out / name, ("id",)) for name in (SUMMARY_FILE, FAILURES_FILE)}
     start = time.perf_counter()
     code = subprocess.run(command).returncode
     wall = time.perf_counter() - start
@@ -502,9 +490,10 @@ def combine(args) -> None:
             rebuilt += 1
         scatter.append(measured[len(rules):].std(axis=0, ddof=1))  # the single answers'
         true_body = truths.vertices[ids.index(subject)]
-        necks.append((measurer.neck_section(true_body), measurer.neck_section(rest[0]),
+        true_neck = measurer.neck_section(true_body)
+        necks.append((true_neck, measurer.neck_section(rest[0]),
                       1000 * stature_m / settings.canvas.body_height_px,
-                      _beyond_the_neck(measurer, true_body)))
+                      _beyond_the_neck(measurer, true_body, true_neck)))
     fit = np.array(errors.get(FIT_RULE, []))
     count = len(fit)
     if count < 2:
@@ -528,15 +517,16 @@ def combine(args) -> None:
     print("\n" + _neck_line(necks))
 
 
-def _beyond_the_neck(measurer: Measurer, vertices: np.ndarray) -> np.ndarray:
-    """(2,) mm: how much wider (x) and deeper (y) than the neck's section the body
-    ``vertices`` (V, 3, rest) is at the height of the neck tape's centre, within 12 cm of
-    it across (no arm): what of the front and side outlines there is another part (the
-    jaw, the chin) than the neck."""
+def _beyond_the_neck(measurer: Measurer, vertices: np.ndarray,
+                     section: np.ndarray) -> np.ndarray:
+    """(2,) mm: how much wider (x) and deeper (y) than its neck's ``section``
+    (``Measurer.neck_section``) the body ``vertices`` (V, 3, rest) is at the height of the
+    neck tape's centre, within 12 cm of it across (no arm): what of the front and side
+    outlines there is another part (the jaw, the chin) than the neck."""
     v = np.asarray(vertices, np.float64)
     centre = measurer.neck_plane(v)[0][0]
     near = (np.abs(v[:, 2] - centre[2]) < 0.003) & (np.abs(v[:, 0] - centre[0]) < 0.12)
-    return 1000 * (np.ptp(v[near, :2], axis=0) - np.ptp(measurer.neck_section(v), axis=0))
+    return 1000 * (np.ptp(v[near, :2], axis=0) - np.ptp(section, axis=0))
 
 
 def _neck_line(necks: list[tuple[np.ndarray, np.ndarray, float, np.ndarray]]) -> str:

@@ -33,14 +33,16 @@ from bodyfit.fitter.measurements import MEASUREMENTS
 from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.run import RUN_FILES
 
-__all__ = ["SUMMARY_FILE", "FAILURES_FILE", "STATUSES", "SUMMARY_COLUMNS", "SummaryRow",
-           "PreviousBatch", "missing_results", "summary_row", "write_tables", "read_previous"]
+__all__ = ["SUMMARY_FILE", "FAILURES_FILE", "STATUSES", "SUMMARY_COLUMNS", "FAILURES_COLUMNS",
+           "SummaryRow", "PreviousBatch", "missing_results", "summary_row", "csv_text",
+           "write_tables", "read_table", "read_previous"]
 
 SUMMARY_FILE, FAILURES_FILE = "summary.csv", "failures.csv"
 STATUSES = ("fitted", "fitted earlier", "failed", "failed earlier", "bad row", "not run")
 _NAMES = [name for name, _ in MEASUREMENTS.values()]
 SUMMARY_COLUMNS = ["id", "status", "best_cost", "seconds"] + [
     column for name in _NAMES for column in (f"{name}_mm", f"{name}_spread_mm")]
+FAILURES_COLUMNS = ["id", "reason"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -84,7 +86,8 @@ def _number(value: float | None, digits: int | None = None) -> str:
     return repr(float(value)) if digits is None else f"{value:.{digits}f}"
 
 
-def _csv_text(header: list[str], records: list[list[str]]) -> str:
+def csv_text(header: list[str], records: list[list[str]]) -> str:
+    """A CSV file's text: ``header``, then ``records`` (rows of cells)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(header)
@@ -106,8 +109,8 @@ def write_tables(out_dir: Path, rows: list[SummaryRow]) -> tuple[Path, Path]:
                 if row.status in ("failed", "failed earlier", "bad row")]
     paths = out_dir / SUMMARY_FILE, out_dir / FAILURES_FILE
     # failures first: a rerun takes a subject's failure from summary.csv, its reason from here
-    write_text(paths[1], _csv_text(["id", "reason"], failures))
-    write_text(paths[0], _csv_text(SUMMARY_COLUMNS, summary))
+    write_text(paths[1], csv_text(FAILURES_COLUMNS, failures))
+    write_text(paths[0], csv_text(SUMMARY_COLUMNS, summary))
     return paths
 
 
@@ -124,7 +127,12 @@ class PreviousBatch:
     seconds: dict[str, float]
 
 
-def _read_table(path: Path, columns: tuple[str, ...]) -> list[dict[str, str]]:
+def read_table(path: Path, columns: tuple[str, ...]) -> list[dict[str, str]]:
+    """The rows of the batch table ``path`` (none when there is no file).
+
+    Raises:
+        UserError: it lacks ``columns`` or cannot be read.
+    """
     try:
         with open(path, newline="", encoding="utf-8") as stream:
             reader = csv.DictReader(stream)
@@ -145,9 +153,9 @@ def read_previous(out_dir: Path) -> PreviousBatch:
     Raises:
         UserError: summary.csv or failures.csv is there but is not a batch's table.
     """
-    summary = _read_table(out_dir / SUMMARY_FILE, ("id", "status", "seconds"))
+    summary = read_table(out_dir / SUMMARY_FILE, ("id", "status", "seconds"))
     reasons = {row["id"]: row["reason"]
-               for row in _read_table(out_dir / FAILURES_FILE, ("id", "reason"))}
+               for row in read_table(out_dir / FAILURES_FILE, ("id", "reason"))}
     failed, seconds = {}, {}
     for row in summary:
         if row["status"] in ("failed", "failed earlier"):
