@@ -278,6 +278,7 @@ def _cmd_demo(args) -> None:
                                      write_scene)
     from bodyfit.fitter.model_cache import load_model
     from bodyfit.fitter.run import run_person
+    from bodyfit.fitter.spreads import SPREAD_NOTES
 
     if args.generations is not None and args.generations < 1:
         raise UserError(f"--generations must be at least 1, got {args.generations}")
@@ -304,7 +305,8 @@ def _cmd_demo(args) -> None:
     print(f"fitted in {sum(fit.seconds.values()):.1f} s: {result.evaluations} candidates, "
           f"{result.generations} generations ({settings.search.optimizer}, "
           f"{settings.projection})")
-    print("\n".join(measurement_table(fit.measurements, scene.truth)))
+    print("\n".join(measurement_table(fit.measurements, fit.spreads, scene.truth)))
+    print(f"  ({SPREAD_NOTES[fit.spread_basis]})")
     print("wrote:")
     for path in (scene.front, scene.side, scene.board_photos[0].parent, camera_path,
                  coverage_path, scene.truth_file, *written):
@@ -341,6 +343,7 @@ def _cmd_run(args) -> None:
     from bodyfit.fitter.measurements import MEASUREMENTS
     from bodyfit.fitter.model_cache import load_model
     from bodyfit.fitter.run import run_person
+    from bodyfit.fitter.spreads import SPREAD_NOTES
 
     try:
         inputs, settings, output = _run_settings(args)
@@ -355,6 +358,7 @@ def _cmd_run(args) -> None:
     for key, (_, label) in MEASUREMENTS.items():
         print(f"  {key} {label:<28} {fit.measurements[key]:8.1f} ± "
               f"{fit.spreads[key]:5.1f} mm")
+    print(f"  ({SPREAD_NOTES[fit.spread_basis]})")
     print("wrote:")
     for path in written:
         print(f"  {path}")

@@ -154,14 +154,15 @@ def calibrate_scene(scene: DemoScene) -> tuple[Calibration, Path, Path]:
     return calibration, output, coverage
 
 
-def measurement_table(measured: dict[str, float], truth: dict[str, float]) -> list[str]:
+def measurement_table(measured: dict[str, float], spreads: dict[str, float],
+                      truth: dict[str, float]) -> list[str]:
     """Lines of the fitted against the true measurements (mm, key -> value): a header, one
-    row per measurement (value, truth, error), and the mean absolute error of the paper's
-    seven important ones (``IMPORTANT``)."""
-    lines = [f"  {'measurement':<30} {'fitted':>8} {'true':>8} {'error':>7}  (mm)"]
+    row per measurement (value, its ±, truth, error), and the mean absolute error of the
+    paper's seven important ones (``IMPORTANT``)."""
+    lines = [f"  {'measurement':<30} {'fitted':>8} {'±':>6} {'true':>8} {'error':>7}  (mm)"]
     for key, (_, label) in MEASUREMENTS.items():
-        lines.append(f"  {key} {label:<28} {measured[key]:8.1f} {truth[key]:8.1f} "
-                     f"{measured[key] - truth[key]:+7.1f}")
+        lines.append(f"  {key} {label:<28} {measured[key]:8.1f} {spreads[key]:6.1f} "
+                     f"{truth[key]:8.1f} {measured[key] - truth[key]:+7.1f}")
     mae = np.mean([abs(measured[key] - truth[key]) for key in IMPORTANT])
     lines.append(f"  mean absolute error of the 7 important ({', '.join(IMPORTANT)}): "
                  f"{mae:.1f} mm")

@@ -1,11 +1,7 @@
 """One person's fit: silhouettes -> canvases -> search -> body and measurements with spreads.
 
-The measurement spread: the best quarter of the searches' final populations, pooled (at
-least three with a finite cost), are measured like the fitted body, and each
-measurement's spread is their standard deviation, millimetres. It says how well the photos pinned a
-measurement down under this search: a measurement the silhouettes barely constrain
-varies among near-equal candidates. It is not a confidence interval; how often the
-truth falls inside it is for the accuracy benchmark to measure.
+The ± of each measurement: :mod:`bodyfit.fitter.spreads` (calibrated on the accuracy
+benchmark for the default method, the search's own scatter for other settings).
 """
 
 from __future__ import annotations
@@ -21,22 +17,20 @@ from bodyfit import kernels
 from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import POSE_NAMES, BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, orthographic_view
-from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
+from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
 from bodyfit.fitter.search import (SearchResult, SearchSettings, averaged, refined, search,
                                    searches_together)
 from bodyfit.fitter.side_arms import side_view_options
-from bodyfit.fitter.stature import StatureConditioner, scaled_to_stature, stature_scale
+from bodyfit.fitter.spreads import (answer_cost, bodyfit_calibration, calibration_applies,
+                                    population_spreads)
+from bodyfit.fitter.stature import StatureConditioner, stature_scale
 from bodyfit.fitter.weights import cost_settings
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "person_views", "place_cameras",
            "placement_body", "refinement_scoring", "stature_conditioner"]
-
-_SPREAD_SHARE = 0.25
-_SPREAD_MIN = 3
-
 
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
@@ -118,7 +112,8 @@ class Fit:
         posed: (V, 3) float32 metres, the best body in its fitted pose.
         rest: (V, 3) float32 metres, the same body in the rest A-pose.
         measurements: key ("A".."P") -> mm, of ``rest``.
-        spreads: key -> mm, the spread described in the module docstring.
+        spreads: key -> mm, the ± of each measurement (:mod:`bodyfit.fitter.spreads`).
+        spread_basis: which ± ``spreads`` holds, one of ``spreads.SPREAD_BASES``.
         views: the kernels' targets (canvas silhouettes and cameras), by view name.
         seconds: stage -> wall seconds ("canvas", "search", "measure").
         view_bodies: view name -> (V, 3) float32 metres, the best candidate as the search
@@ -131,25 +126,10 @@ class Fit:
     rest: np.ndarray
     measurements: dict[str, float]
     spreads: dict[str, float]
+    spread_basis: str
     views: dict[str, kernels.ViewTarget]
     seconds: dict[str, float]
     view_bodies: dict[str, np.ndarray]
-
-
-def _spreads(model: BodyModel, measurer: Measurer, result: SearchResult,
-             stature_m: float | None) -> dict[str, float]:
-    """The spread of each measurement (module docstring); each candidate rescaled to
-    ``stature_m`` first when given (as the fitted body is)."""
-    finite = np.flatnonzero(np.isfinite(result.final_costs))
-    count = max(_SPREAD_MIN, int(np.ceil(_SPREAD_SHARE * len(result.final_costs))))
-    chosen = finite[np.argsort(result.final_costs[finite])][:count]
-    k = len(result.betas)
-    rest, _ = rest_shape(model, result.final_genes[chosen, :k])
-    if stature_m is not None:
-        rest = scaled_to_stature(rest, stature_m)
-    values = measurer.measure_many(rest)
-    spread = np.nanstd(values, axis=0, ddof=1) if len(chosen) > 1 else np.full(16, np.nan)
-    return dict(zip(MEASUREMENTS, spread.tolist()))
 
 
 def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
@@ -387,7 +367,11 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
         posed, rest = posed * scale, rest * scale
     measurer = Measurer.from_model(model)
     measurements = measurer.measure(rest)
-    spreads = _spreads(model, measurer, result, stature_m if s.condition_stature else None)
+    if calibration_applies(settings, METHODS["bodyfit"]):
+        spreads, basis = bodyfit_calibration().spreads(answer_cost(result)), "calibrated"
+    else:
+        spreads, basis = population_spreads(model, measurer, result, stature_m
+                                            if s.condition_stature else None), "population"
     t3 = time.perf_counter()
-    return Fit(result, posed, rest, measurements, spreads, views,
+    return Fit(result, posed, rest, measurements, spreads, basis, views,
                {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies)

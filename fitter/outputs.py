@@ -95,12 +95,14 @@ def write_measurements(json_path: Path, bodies: dict[str, dict[str, float]],
 
 
 def write_fitted_measurements(json_path: Path, values: dict[str, float],
-                              spreads: dict[str, float], provenance: dict) -> Path:
+                              spreads: dict[str, float], spread_basis: str,
+                              provenance: dict) -> Path:
     """Write one fitted body's 16 measurements with their spreads, JSON and CSV (mm).
 
     Both are keyed by measurement name (``MEASUREMENTS``), with the paper's letter kept
     as a field: ``{"chest_circumference": {"letter": "D", "value_mm": ..., "spread_mm":
-    ...}, ...}``. Returns the CSV path.
+    ...}, ...}``; the JSON also names the kind of spread (``spread_basis``, one of
+    :data:`bodyfit.fitter.spreads.SPREAD_BASES`). Returns the CSV path.
     """
     json_path = Path(json_path)
     table = {name: {"letter": key, "label": label, "value_mm": round(float(values[key]), 2),
@@ -112,6 +114,7 @@ def write_fitted_measurements(json_path: Path, values: dict[str, float],
     for name, row in table.items():
         writer.writerow([name, row["letter"], f"{row['value_mm']:.2f}", f"{row['spread_mm']:.2f}"])
     csv_path = json_path.with_suffix(".csv")
-    write_json(json_path, {"units": "mm", "measurements": table, "provenance": provenance})
+    write_json(json_path, {"units": "mm", "spread_basis": spread_basis, "measurements": table,
+                           "provenance": provenance})
     write_text(csv_path, buffer.getvalue())
     return csv_path

@@ -14,6 +14,7 @@ import numpy as np
 
 from bodyfit.calib.images import encode_image
 from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
+from bodyfit.fitter.spreads import SPREAD_NOTES
 
 __all__ = ["REPORT_PICTURES", "png_data_uri", "report_html"]
 
@@ -73,7 +74,7 @@ def _measurement_table(values: dict[str, float], spreads: dict[str, float]) -> s
                     f'<td class="num">{values[key]:.1f}</td>'
                     f'<td class="num">± {spreads[key]:.1f}</td></tr>')
     return ("<table><thead><tr><th>letter</th><th>measurement</th><th>value (mm)</th>"
-            "<th>spread (mm)</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
+            "<th>± (mm)</th></tr></thead><tbody>" + "".join(rows) + "</tbody></table>")
 
 
 def _settings_rows(record: dict) -> list[tuple[str, str]]:
@@ -102,13 +103,14 @@ def _weight_rows(weights: dict[str, float]) -> list[tuple[str, str]]:
 
 
 def report_html(record: dict, values: dict[str, float], spreads: dict[str, float],
-                images: dict[str, np.ndarray]) -> str:
+                spread_basis: str, images: dict[str, np.ndarray]) -> str:
     """The report page.
 
     Args:
         record: the run.json payload (:func:`bodyfit.fitter.run.run_record`), its weights
             included.
         values, spreads: measurement key ("A".."P") -> mm.
+        spread_basis: the kind of spread, a key of :data:`bodyfit.fitter.spreads.SPREAD_NOTES`.
         images: one (H, W, 3) uint8 BGR picture per key of ``REPORT_PICTURES``.
     """
     inputs, result = record["inputs"], record["result"]
@@ -128,8 +130,7 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
 <body>
 <h1>bodyfit: fitted body and measurements</h1>
 <p class="note">bodyfit {_e(record["versions"].get("bodyfit", "?"))}, <code>fitter run</code>.
-The measurements are those of the fitted body model; the spread is their standard
-deviation over the best quarter of the searches' final populations, not a confidence interval.</p>
+The measurements are those of the fitted body model; {_e(SPREAD_NOTES[spread_basis])}.</p>
 <table>{_rows(given)}</table>
 
 <h2>Silhouettes</h2>

@@ -4,7 +4,8 @@ Outputs, written atomically into OUT (a failed run leaves OUT as it was):
 
 - ``mesh.obj``, ``mesh.ply``: the fitted body in its fitted pose, metres, model frame;
 - ``mesh_rest.ply``: the same body in the rest A-pose (where it is measured);
-- ``measurements.json`` / ``.csv``: the 16 measurements with their spreads, mm;
+- ``measurements.json`` / ``.csv``: the 16 measurements with their ± (``spread_mm``, mm;
+  :mod:`bodyfit.fitter.spreads`; the JSON names its kind, ``spread_basis``);
 - ``convergence.png``: the best and mean cost per generation;
 - ``run.json``: inputs, settings, weights, seed, versions, timings, best cost, parameters,
   the answers averaged into the fit's (``result.averaged``: each one's betas, angles and
@@ -126,6 +127,7 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
                                ("mesh_rest.ply", fit.rest)):
             write_mesh(stage / name, vertices, model.faces)
         write_fitted_measurements(stage / "measurements.json", fit.measurements, fit.spreads,
+                                  fit.spread_basis,
                                   {"command": "fitter run", "front": inputs.front,
                                    "side": inputs.side, "height_cm": inputs.height_cm})
         write_image(stage / "convergence.png", chart)
@@ -138,5 +140,6 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
             pictures[f"outline_{name}"] = fitted_outline_image(matched)
             write_image(stage / f"overlay_{name}.png", pictures[f"overlay_{name}"])
         write_text(stage / "report.html",
-                   report_html(record, fit.measurements, fit.spreads, pictures))
+                   report_html(record, fit.measurements, fit.spreads, fit.spread_basis,
+                               pictures))
     return fit, [out_dir / name for name in RUN_FILES]

@@ -23,6 +23,9 @@
     # other ways to combine the refinements' answers a run's fits averaged (run.json);
     # last, where the fits' neck circumference goes wrong (its section's width and depth)
     python tools/bench_accuracy.py combine SETS/in default
+    # the calibrated ± (fitter/spreads.py): the factors a run gives, how often the truth
+    # lies within bodyfit's calibration's ±; --write makes a calibration of the run's
+    python tools/bench_accuracy.py spread SETS/out default --write fitter/data/spread_calibration.json
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # does the cost tell the truth's closest body from the fit's answer (search or photos?)
@@ -63,6 +66,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from scipy import stats
 
 from bodyfit.calib.images import write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
@@ -89,6 +93,7 @@ from bodyfit.fitter.outputs import write_text
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import read_run_config, run_config
 from bodyfit.fitter.sections import hull_perimeter
+from bodyfit.fitter.spreads import SpreadCalibration, bodyfit_calibration, recorded_answer_cost
 from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
@@ -517,6 +522,56 @@ def combine(args) -> None:
     print("\n" + _neck_line(necks))
 
 
+def spread(args) -> None:
+    """The calibrated ± (:mod:`bodyfit.fitter.spreads`) on a run's fits: the factors its
+    subjects give (each measurement's quantile of |error| / answer cost), and how often the
+    truth lies within the ± of bodyfit's own calibration (``fitter/data``; a test of it on
+    subjects it was not made from) and within the fits' own reported spreads. ``--write
+    FILE`` writes the run's factors as a calibration. (On the subjects it is made from, a
+    calibration holds the truth for its coverage by construction, and so would each
+    subject left out of it: the quantile's rank does not depend on the errors.) Last, how
+    well a fit's answer cost and its reported spread rank the subjects by their errors."""
+    folder = Path(args.set)
+    runs = [_run_folder(folder, name) for name in args.names]
+    scores, _ = _run_scores(folder, runs, args.first)
+    holder = {subject: run for run, own in _joined(runs, _fit_records(scores.ids))
+              for subject in own}
+    costs = np.array([recorded_answer_cost(json.loads((holder[s] / s / "run.json").read_text()))
+                      for s in scores.ids])
+    made = SpreadCalibration.made_from(scores.errors, costs,
+                                       "python tools/bench_accuracy.py " + " ".join(sys.argv[1:]))
+    own = bodyfit_calibration()
+    absolute = np.abs(scores.errors)
+    columns = {f"bodyfit's calibration ({own.subjects} subjects)": np.mean(
+                   absolute <= np.array([list(own.spreads(c).values()) for c in costs]), axis=0),
+               "the same, unscaled (its ± at its median cost)": np.mean(
+                   absolute <= np.array(list(own.spreads(own.median_cost).values())), axis=0),
+               "the fits' reported spreads": np.mean(absolute <= scores.spreads, axis=0)}
+    print(f"{folder}: {'+'.join(args.names)}, {len(costs)} subjects; answer cost (weighted mm) "
+          f"median {np.median(costs):.1f}, {costs.min():.1f}-{costs.max():.1f} (bodyfit's "
+          f"calibration's median {own.median_cost:.1f})\n\n"
+          "| measurement | these fits' factor (mm per weighted mm) | bodyfit's | truth within: "
+          + " | ".join(columns) + " |\n|---|---|---|" + "---|" * len(columns))
+    for j, (key, (_, label)) in enumerate(MEASUREMENTS.items()):
+        print(f"| {key} {label} | {made.per_cost[key]:.3f} | {own.per_cost[key]:.3f} | "
+              + " | ".join(f"{share[j]:.0%}" for share in columns.values()) + " |")
+    shown = [KEYS.index(key) for key in KEYS if key != "O"]  # the given stature: always ~0
+    print("| all but O (the given stature) | | | "
+          + " | ".join(f"{share[shown].mean():.1%}" for share in columns.values()) + " |")
+    # does a fit's answer cost, or its reported spread, rank the subjects by their errors?
+    scaled = (absolute / np.sqrt(np.mean(absolute ** 2, axis=0)))[:, shown].ravel()
+    ranks = {"its answer cost": np.repeat(costs, len(shown)),
+             "its reported spread": (scores.spreads[:, shown]
+                                     / np.median(scores.spreads[:, shown], axis=0)).ravel()}
+    print("\nSpearman's rank correlation of a subject's |error| (each measurement's divided by "
+          "its RMS, all but O pooled) with "
+          + "; with ".join(f"{name}: {stats.spearmanr(scaled, values)[0]:+.2f}"
+                           for name, values in ranks.items()))
+    if args.write:
+        write_text(Path(args.write), json.dumps(made.as_json(), indent=2) + "\n")
+        print(f"\nwrote {args.write}")
+
+
 def _beyond_the_neck(measurer: Measurer, vertices: np.ndarray,
                      section: np.ndarray) -> np.ndarray:
     """(2,) mm: how much wider (x) and deeper (y) than its neck's ``section``
@@ -709,6 +764,17 @@ def figures(args) -> None:
     print(f"wrote {args.docs}/accuracy_error_per_generation.png, {args.docs}/accuracy_meshes.png")
 
 
+def _joined_runs_parser(sub, command: str, description: str) -> argparse.ArgumentParser:
+    """A subcommand over a set and runs of it joined, with ``--first``."""
+    p = sub.add_parser(command, help=description)
+    p.add_argument("set")
+    p.add_argument("names", nargs="+", metavar="name",
+                   help="runs (SET/runs/NAME, or a folder of `keep`), joined: each "
+                   "subject from the first")
+    p.add_argument("--first", type=int, help="the set's first N subjects only")
+    return p
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -737,15 +803,15 @@ def main() -> None:
     p.add_argument("name", help="the run's name (SET/runs/NAME)")
     p.add_argument("--to", default="docs/accuracy-runs",
                    help="folder of kept runs: TO/<set kind>/NAME/ (default: %(default)s)")
-    p = sub.add_parser("combine", help="other ways to combine the answers a run's fits "
-                       "averaged")
-    p.add_argument("set")
-    p.add_argument("names", nargs="+", metavar="name",
-                   help="runs (SET/runs/NAME, or a folder of `keep`), joined: each "
-                   "subject from the first")
-    p.add_argument("--first", type=int, help="the set's first N subjects only")
+    p = _joined_runs_parser(sub, "combine", "other ways to combine the answers a run's fits "
+                            "averaged")
     p.add_argument("--answers", type=int, metavar="N",
                    help="each fit's first N answers only (as --refinements N would give)")
+    p = _joined_runs_parser(sub, "spread", "the calibrated ± on a run's fits: their factors, "
+                            "how often the truth lies within")
+    p.add_argument("--write", metavar="FILE",
+                   help="write the run's factors as a calibration (bodyfit's own: "
+                   "fitter/data/spread_calibration.json)")
     p = sub.add_parser("report", help="Markdown tables of runs")
     p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "
@@ -796,7 +862,7 @@ def main() -> None:
     else:
         {"make": make, "keep": keep, "combine": combine, "report": report,
          "outlines": outlines, "floor": floor, "costs": costs, "budgets": budgets,
-         "figures": figures}[args.command](args)
+         "figures": figures, "spread": spread}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ from bodyfit.fitter.accuracy.scores import error_stats
 from bodyfit.fitter.body_model import forward, project_shape, rest_shape
 from bodyfit.fitter.model_cache import CACHE_ENV_VAR
 from bodyfit.fitter.side_arms import side_photo_pose
+from bodyfit.fitter.spreads import read_calibration
 
 TOOL = Path(__file__).parents[2] / "tools" / "bench_accuracy.py"
 
@@ -203,6 +204,16 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     printed = tool("combine", str(subject_set), "small", "--answers", "3")
     assert "averaged 3 answers" in printed and "rebuilt" not in printed
     assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) ", printed)[1] == first3
+    # the calibrated ± on these fits: the factors printed are those written (a round trip
+    # through the calibration file), made from the 4 subjects
+    written = tmp_path / "spread_calibration.json"
+    printed = tool("spread", str(subject_set), "small", "--write", str(written))
+    calibration = read_calibration(written.read_text())
+    assert calibration.subjects == 4 and "spread" in calibration.source
+    factors = dict(re.findall(r"^\| ([A-P]) [^|]+\| ([.\d]+) \|", printed, re.M))
+    assert factors.keys() == calibration.per_cost.keys()
+    for key, factor in factors.items():
+        assert float(factor) == pytest.approx(calibration.per_cost[key], abs=5e-4)
     # the truth's closest body scored on the fit's views: drawn from the space the fit
     # searches, it is cheaper than a 60-generation search's answer
     printed = tool("costs", str(subject_set), "small", "--first", "2")

@@ -32,6 +32,7 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     from bodyfit.fitter.demo import DemoSettings, demo_camera
     from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS
     from bodyfit.fitter.run import RUN_FILES
+    from bodyfit.fitter.spreads import SPREAD_NOTES
 
     monkeypatch.chdir(tmp_path)
     code, out, err = run(capsys, "-q", "demo", "-o", "demo", "--generations", "3")
@@ -63,15 +64,19 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     assert (search["generations"], search["refine_generations"]) == (3, 3)
     assert search["refine_components"] == 40 and len(record["result"]["betas"]) == 40
     assert record["inputs"]["camera"] == "demo/camera.json"
-    fitted = {row["letter"]: row["value_mm"] for row in json.loads(
-        (out_dir / "fit" / "measurements.json").read_text())["measurements"].values()}
+    written = json.loads((out_dir / "fit" / "measurements.json").read_text())
+    fitted = {row["letter"]: row["value_mm"] for row in written["measurements"].values()}
+    spreads = {row["letter"]: row["spread_mm"] for row in written["measurements"].values()}
     assert abs(fitted["O"] - truth["O"]) < 15.0
-    # the printed table: 16 rows of fitted, true and error, then the important ones' mean
-    rows = re.findall(r"^  ([A-P]) .+? +(-?\d+\.\d) +(-?\d+\.\d) +([+-]\d+\.\d)$", out,
-                      re.MULTILINE)
+    # the printed table: 16 rows of fitted, ±, true and error, then the important ones'
+    # mean; the ±'s kind named (3 generations are not the default method: the population's)
+    rows = re.findall(r"^  ([A-P]) .+? +(-?\d+\.\d) +(\d+\.\d) +(-?\d+\.\d) +([+-]\d+\.\d)$",
+                      out, re.MULTILINE)
     assert [key for key, *_ in rows] == list(MEASUREMENTS)
-    for key, value, true, error in rows:
+    assert written["spread_basis"] == "population" and SPREAD_NOTES["population"] in out
+    for key, value, spread, true, error in rows:
         assert float(value) == pytest.approx(fitted[key], abs=0.06)
+        assert float(spread) == pytest.approx(spreads[key], abs=0.06)
         assert float(true) == pytest.approx(truth[key], abs=0.06)
         assert float(error) == pytest.approx(fitted[key] - truth[key], abs=0.11)
     mae = float(re.search(r"7 important .*: (\d+\.\d) mm", out).group(1))

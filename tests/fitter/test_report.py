@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from bodyfit.calib.errors import UserError
+from bodyfit.fitter import fit as fit_module
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.body_model import PART_NAMES
 from bodyfit.fitter.fit import FitSettings
@@ -20,6 +21,7 @@ from bodyfit.fitter.person import PersonInputs
 from bodyfit.fitter.render import PART_COLOURS_BGR
 from bodyfit.fitter.run_config import read_run_config, run_config
 from bodyfit.fitter.search import SearchSettings
+from bodyfit.fitter.spreads import SPREAD_NOTES, bodyfit_calibration, recorded_answer_cost
 from bodyfit.fitter.studio_photos import write_subject
 from bodyfit.kernels import CostSettings
 
@@ -198,3 +200,28 @@ def test_components_at_or_past_the_refinement_turn_it_off(options, refine):
     assert settings.search.refine_components == refine
     assert fit_settings(METHODS["paper"], options).search.refine_components == options.get(
         "refine_components", 0)
+
+
+def test_the_default_method_reports_the_calibrated_spread(first_run, tmp_path, capsys,
+                                                           monkeypatch):
+    """A run of other settings than the default method's reports its population's spread;
+    one of the default method (here: the first run's settings made the default), with
+    another seed, the calibrated ± (fitter/spreads.py): each measurement's factor times
+    the answers' mean cost, as written in run.json."""
+    first = json.loads((first_run / "measurements.json").read_text())
+    assert first["spread_basis"] == "population"
+    assert SPREAD_NOTES["population"] in html.unescape((first_run / "report.html").read_text())
+    monkeypatch.setitem(fit_module.METHODS, "bodyfit",
+                        read_run_config(first_run / "run.json").settings)
+    out = tmp_path / "calibrated"
+    assert main(["run", "--config", str(first_run / "run.json"), "-o", str(out),
+                 "--seed", "6", "--threads", "1"]) == 0
+    assert SPREAD_NOTES["calibrated"] in capsys.readouterr().out
+    written = json.loads((out / "measurements.json").read_text())
+    assert written["spread_basis"] == "calibrated"
+    cost = recorded_answer_cost(json.loads((out / "run.json").read_text()))
+    factors = bodyfit_calibration().per_cost
+    for key, (name, _) in MEASUREMENTS.items():
+        assert written["measurements"][name]["spread_mm"] == pytest.approx(
+            factors[key] * cost, abs=0.006)
+    assert SPREAD_NOTES["calibrated"] in html.unescape((out / "report.html").read_text())
