@@ -13,7 +13,7 @@ Two kinds (``SPREAD_BASES``):
   step 27, with the coverage measured on subjects the factors were not made from). The
   cost scales the ± because a body the model's space cannot reproduce leaves its
   silhouettes matched worse: the in-space subjects' answer costs are about two thirds of
-  the out-of-space ones', and so are their errors. Real photos (clothes, hair, a
+  the out-of-space ones', their errors smaller still. Real photos (clothes, hair, a
   segmentation less clean than the benchmark's) may err more than this ± says.
 - ``"population"``, for any other settings: the best quarter of the searches' final
   populations, pooled (at least three with a finite cost), are measured like the fitted
