@@ -77,9 +77,9 @@ class SearchSettings:
             body the silhouettes fix, each by about its error (the cost is flat across
             millimetres of shape), so their mean is nearer: four against two, -0.42 mm
             in-space and -0.40 out-of-space on the first 40 subjects of each set
-            (docs/accuracy.md, step 16); six against four, -0.17 +- 0.11 mm over 49
+            (docs/accuracy.md, step 16); six against four, -0.17 +- 0.12 mm over 52
             subjects of both sets, each subject's own fits, for 1.43x the candidates
-            (steps 24-26).
+            (steps 24-27).
     """
 
     optimizer: str = "cmaes"

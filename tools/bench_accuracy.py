@@ -533,7 +533,7 @@ def spread(args) -> None:
     well a fit's answer cost and its reported spread rank the subjects by their errors."""
     folder = Path(args.set)
     runs = [_run_folder(folder, name) for name in args.names]
-    scores, _ = _run_scores(folder, runs, args.first)
+    scores, _ = _run_scores(folder, runs, args.first, args.skip)
     holder = {subject: run for run, own in _joined(runs, _fit_records(scores.ids))
               for subject in own}
     costs = np.array([recorded_answer_cost(json.loads((holder[s] / s / "run.json").read_text()))
@@ -563,10 +563,11 @@ def spread(args) -> None:
     ranks = {"its answer cost": np.repeat(costs, len(shown)),
              "its reported spread": (scores.spreads[:, shown]
                                      / np.median(scores.spreads[:, shown], axis=0)).ravel()}
-    print("\nSpearman's rank correlation of a subject's |error| (each measurement's divided by "
-          "its RMS, all but O pooled) with "
-          + "; with ".join(f"{name}: {stats.spearmanr(scaled, values)[0]:+.2f}"
-                           for name, values in ranks.items()))
+    if len(costs) >= 3:
+        print("\nSpearman's rank correlation of a subject's |error| (each measurement's divided "
+              "by its RMS, all but O pooled) with "
+              + "; with ".join(f"{name}: {stats.spearmanr(scaled, values)[0]:+.2f}"
+                               for name, values in ranks.items()))
     if args.write:
         write_text(Path(args.write), json.dumps(made.as_json(), indent=2) + "\n")
         print(f"\nwrote {args.write}")
@@ -634,11 +635,13 @@ def _run_spec(spec: str) -> tuple[str, Path, list[Path]]:
                                      for name in names.split("+")]
 
 
-def _run_scores(set_folder: Path, runs: list[Path], first: int | None) -> tuple[RunScores, str]:
+def _run_scores(set_folder: Path, runs: list[Path], first: int | None,
+                skip: int = 0) -> tuple[RunScores, str]:
     """The joined scores of ``runs`` (each subject from the first run holding it, fitted or
-    failed), over the set's first ``first`` subjects, and where and how fast each part went."""
+    failed), over the set's first ``first`` subjects but the first ``skip``, and where and
+    how fast each part went."""
     every = {run: read_scores(set_folder, run) for run in runs}
-    parts = [(run, _first(_subset(every[run], own), set_folder, first)) for run, own in
+    parts = [(run, _first(_subset(every[run], own), set_folder, first, skip)) for run, own in
              _joined(runs, lambda run: every[run].ids + [s for s, _ in every[run].failures])]
     joined = dataclasses.replace(
         parts[0][1], ids=[i for _, s in parts for i in s.ids],
@@ -701,12 +704,12 @@ def report(args) -> None:
             print("\n".join(paired_measurement_table(table4[label], table4[baseline])))
 
 
-def _first(scores, set_folder: Path, first: int | None):
-    """The scores of the set's first ``first`` subjects (those of `fit --first N`); all
-    when None."""
+def _first(scores, set_folder: Path, first: int | None, skip: int = 0):
+    """The scores of the set's first ``first`` subjects but the first ``skip`` (those of
+    `fit --first N --skip I`); all when ``first`` is None."""
     if not first:
         return scores
-    rows = _table_rows(set_folder, first)[1:]
+    rows = _table_rows(set_folder, first, skip=skip)[1:]
     return _subset(scores, {row.split(",")[0] for row in rows})
 
 
@@ -809,6 +812,9 @@ def main() -> None:
                    help="each fit's first N answers only (as --refinements N would give)")
     p = _joined_runs_parser(sub, "spread", "the calibrated ± on a run's fits: their factors, "
                             "how often the truth lies within")
+    p.add_argument("--skip", type=int, default=0, metavar="I",
+                   help="with --first N: rows I to N - 1 only (e.g. rows a calibration was "
+                   "not made from)")
     p.add_argument("--write", metavar="FILE",
                    help="write the run's factors as a calibration (bodyfit's own: "
                    "fitter/data/spread_calibration.json)")
