@@ -109,7 +109,8 @@ def read_calibration(text: str | None = None) -> SpreadCalibration:
     """The calibration in ``text`` (JSON), or bodyfit's own (``data/``) when None.
 
     Raises:
-        ValueError: not a calibration of this format, or a measurement missing.
+        ValueError: not a calibration of this format.
+        KeyError: a field or a measurement missing.
     """
     if text is None:
         text = resources.files("bodyfit.fitter.data").joinpath(CALIBRATION_FILE).read_text()
