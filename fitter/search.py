@@ -77,7 +77,7 @@ class SearchSettings:
             body the silhouettes fix, each by about its error (the cost is flat across
             millimetres of shape), so their mean is nearer: four against two, -0.42 mm
             in-space and -0.40 out-of-space on the first 40 subjects of each set
-            (docs/accuracy.md, step 16); six against four, -0.17 +- 0.12 mm over 52
+            (docs/accuracy.md, step 16); six against four, -0.18 +- 0.11 mm over 54
             subjects of both sets, each subject's own fits, for 1.43x the candidates
             (steps 24-27).
     """
