@@ -316,6 +316,12 @@ def _fit_records(subjects: list[str]):
     return lambda run: {s for s in subjects if (run / s / "run.json").exists()}
 
 
+def _record_holders(runs: list[Path], subjects: list[str]) -> dict[str, Path]:
+    """subject -> the first of the joined ``runs`` that holds its fit record (run.json)."""
+    return {subject: run for run, own in _joined(runs, _fit_records(subjects))
+            for subject in own}
+
+
 def _budget_errors(model, bodies, run: Path, subjects: list[str],
                    budgets: list[int]) -> np.ndarray:
     """(S, len(budgets), 7) |error| (mm) of the 7 important measurements of ``run``'s fits
@@ -445,9 +451,7 @@ def combine(args) -> None:
     necks = []  # per subject, what _neck_line reads
     subjects = [row.split(",")[0] for row in
                 (folder / "subjects.csv").read_text().splitlines()[1:][:args.first]]
-    holder = {subject: run for run, own in _joined(
-        [_run_folder(folder, name) for name in args.names], _fit_records(subjects))
-        for subject in own}
+    holder = _record_holders([_run_folder(folder, name) for name in args.names], subjects)
     for subject in (s for s in subjects if s in holder):
         run = holder[subject]
         record = json.loads((run / subject / "run.json").read_text())
@@ -534,8 +538,7 @@ def spread(args) -> None:
     folder = Path(args.set)
     runs = [_run_folder(folder, name) for name in args.names]
     scores, _ = _run_scores(folder, runs, args.first, args.skip)
-    holder = {subject: run for run, own in _joined(runs, _fit_records(scores.ids))
-              for subject in own}
+    holder = _record_holders(runs, scores.ids)
     costs = np.array([recorded_answer_cost(json.loads((holder[s] / s / "run.json").read_text()))
                       for s in scores.ids])
     made = SpreadCalibration.made_from(scores.errors, costs,
@@ -558,12 +561,11 @@ def spread(args) -> None:
     shown = [KEYS.index(key) for key in KEYS if key != "O"]  # the given stature: always ~0
     print("| all but O (the given stature) | | | "
           + " | ".join(f"{share[shown].mean():.1%}" for share in columns.values()) + " |")
-    # does a fit's answer cost, or its reported spread, rank the subjects by their errors?
-    scaled = (absolute / np.sqrt(np.mean(absolute ** 2, axis=0)))[:, shown].ravel()
-    ranks = {"its answer cost": np.repeat(costs, len(shown)),
-             "its reported spread": (scores.spreads[:, shown]
-                                     / np.median(scores.spreads[:, shown], axis=0)).ravel()}
-    if len(costs) >= 3:
+    if len(costs) >= 3:  # does a fit's answer cost, or its spread, rank subjects by error?
+        scaled = (absolute / np.sqrt(np.mean(absolute ** 2, axis=0)))[:, shown].ravel()
+        ranks = {"its answer cost": np.repeat(costs, len(shown)),
+                 "its reported spread": (scores.spreads[:, shown]
+                                         / np.median(scores.spreads[:, shown], axis=0)).ravel()}
         print("\nSpearman's rank correlation of a subject's |error| (each measurement's divided "
               "by its RMS, all but O pooled) with "
               + "; with ".join(f"{name}: {stats.spearmanr(scaled, values)[0]:+.2f}"

@@ -26,6 +26,7 @@ import dataclasses
 import io
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 from bodyfit.calib.errors import UserError
@@ -127,7 +128,7 @@ class PreviousBatch:
     seconds: dict[str, float]
 
 
-def read_table(path: Path, columns: tuple[str, ...]) -> list[dict[str, str]]:
+def read_table(path: Path, columns: Sequence[str]) -> list[dict[str, str]]:
     """The rows of the batch table ``path`` (none when there is no file).
 
     Raises:
@@ -155,7 +156,7 @@ def read_previous(out_dir: Path) -> PreviousBatch:
     """
     summary = read_table(out_dir / SUMMARY_FILE, ("id", "status", "seconds"))
     reasons = {row["id"]: row["reason"]
-               for row in read_table(out_dir / FAILURES_FILE, ("id", "reason"))}
+               for row in read_table(out_dir / FAILURES_FILE, FAILURES_COLUMNS)}
     failed, seconds = {}, {}
     for row in summary:
         if row["status"] in ("failed", "failed earlier"):
