@@ -18,6 +18,7 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import POSE_NAMES, BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.photo_extents import ViewPhoto, photo_scaled_girths
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
 from bodyfit.fitter.search import (SearchResult, SearchSettings, averaged, refined, search,
@@ -29,8 +30,9 @@ from bodyfit.fitter.stature import StatureConditioner, stature_scale
 from bodyfit.fitter.weights import cost_settings
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "person_views", "place_cameras",
-           "placement_body", "refinement_scoring", "stature_conditioner"]
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fitted_bodies", "fitted_measurements",
+           "person_views", "place_cameras", "placement_body", "refinement_scoring",
+           "stature_conditioner", "view_photos"]
 
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
@@ -57,6 +59,10 @@ class FitSettings:
             from its best body so far (evenly spaced through the generations;
             :func:`~bodyfit.fitter.pinhole_canvas.placed_anew`); 0: only from the mean
             body, before the search.
+        photo_extents: pinhole only: the girths of
+            :data:`~bodyfit.fitter.photo_extents.PHOTO_EXTENTS` take their section's
+            extents from the photos (:mod:`bodyfit.fitter.photo_extents`); False: every
+            measurement is the fitted mesh's.
     """
 
     search: SearchSettings = SearchSettings()
@@ -70,6 +76,7 @@ class FitSettings:
     side_arms: str = "down"
     projection: str = "pinhole"
     placement_rounds: int = 2
+    photo_extents: bool = True
 
     def validate(self, stored_components: int) -> None:
         """Raise UserError for settings no person could be fitted with (one line, naming
@@ -91,7 +98,7 @@ class FitSettings:
 #: docs/fitter.md "Choosing the defaults") and the paper's method exactly (Sections
 #: 3.3-3.4): one search, its GA at 30 x 25 over all 20 betas and the 4 angles, no
 #: refinement, Table 2's weights, the person -> model matching, the moments' alignment,
-#: its 512 px canvases.
+#: its 512 px canvases, every measurement the fitted mesh's.
 METHODS = {
     "bodyfit": FitSettings(),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
@@ -99,7 +106,7 @@ METHODS = {
                                                searches=1, refine_components=0),
                          canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
                          projection="orthographic",
-                         render_cell_mm=0.0, placement_rounds=0),
+                         render_cell_mm=0.0, placement_rounds=0, photo_extents=False),
 }
 
 
@@ -322,6 +329,50 @@ def _refined(model, views, stature_m, first: SearchResult, settings, progress) -
                    else _mean_of(results, evaluator, conditioner))
 
 
+def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
+                  views: dict[str, kernels.ViewTarget], stature_m: float,
+                  condition_stature: bool) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The fit's bodies of its answer (betas (K,), pose (4,) degrees), float32 metres:
+    (posed (V, 3), rest (V, 3), view name -> (V, 3) in that view's pose), the posed and
+    rest bodies rescaled to the stature when the search conditioned it (a posed height
+    conditioned, or a first beta at its limit), the view bodies as the search scored them."""
+    posed = forward(model, betas[None], pose_deg[None])[0]
+    view_bodies = {name: forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
+                   for name, view in views.items()}
+    rest = rest_shape(model, betas[None])[0][0]
+    if condition_stature:
+        scale = stature_scale(rest, stature_m)
+        posed, rest = posed * scale, rest * scale
+    return posed, rest, view_bodies
+
+
+def view_photos(settings: FitSettings, views: dict[str, kernels.ViewTarget],
+                view_bodies: dict[str, np.ndarray], masks: dict[str, np.ndarray],
+                intrinsics: dict[str, np.ndarray] | None) -> dict[str, ViewPhoto] | None:
+    """The photos the measurements take extents from (:mod:`bodyfit.fitter.photo_extents`),
+    by view name, with the fitted body in each view's pose; None when the settings take
+    none (``photo_extents`` off, or orthographic views). Arguments as
+    :func:`fitted_measurements`'."""
+    if not (settings.photo_extents and settings.projection == "pinhole"):
+        return None
+    return {name: ViewPhoto(name, masks[name], intrinsics[name], view_bodies[name],
+                            view.visible_parts) for name, view in views.items()}
+
+
+def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSettings,
+                        rest: np.ndarray, view_bodies: dict[str, np.ndarray],
+                        views: dict[str, kernels.ViewTarget], masks: dict[str, np.ndarray],
+                        intrinsics: dict[str, np.ndarray] | None) -> dict[str, float]:
+    """key -> mm: the 16 measurements of the fitted ``rest`` body, the girths of
+    ``PHOTO_EXTENTS`` scaled to the photos (:func:`view_photos`); the other arguments as
+    :func:`fit_person`'s and :func:`fitted_bodies`' answers."""
+    measurements = measurer.measure(rest)
+    photos = view_photos(settings, views, view_bodies, masks, intrinsics)
+    if photos is not None:
+        measurements |= photo_scaled_girths(model, measurer, rest, photos)
+    return measurements
+
+
 # One BLAS thread for the whole fit: its matrices are small (CMA-ES's 24 x 24, the
 # conditioner's, the forward's), and OpenBLAS's idle threads spin on the cores the
 # kernels' threads evaluate the population on (one fit: 22.5 -> 14.9 s with the search
@@ -357,16 +408,11 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     if s.refine_components:
         result = _refined(model, views, stature_m, result, settings, progress)
     t2 = time.perf_counter()
-    betas = result.betas[None]
-    posed = forward(model, betas, result.pose_deg[None])[0]
-    view_bodies = {name: forward(model, betas, view.view_pose(result.pose_deg[None]))[0]
-                   for name, view in views.items()}
-    rest = rest_shape(model, betas)[0][0]
-    if s.condition_stature:  # posed height conditioned, or a first beta at its limit: rescale
-        scale = stature_scale(rest, stature_m)
-        posed, rest = posed * scale, rest * scale
+    posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
+                                             stature_m, s.condition_stature)
     measurer = Measurer.from_model(model)
-    measurements = measurer.measure(rest)
+    measurements = fitted_measurements(model, measurer, settings, rest, view_bodies, views,
+                                       masks, intrinsics)
     if calibration_applies(settings, METHODS["bodyfit"]):
         spreads, basis = bodyfit_calibration().spreads(answer_cost(result)), "calibrated"
     else:

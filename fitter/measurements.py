@@ -61,7 +61,7 @@ import numpy as np
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
 from bodyfit.fitter.sections import mesh_edges, region_edges, section_points, tape_lengths
 
-__all__ = ["MEASUREMENTS", "IMPORTANT", "Measurer"]
+__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "Measurer"]
 
 #: key -> (snake_case name, human name), in the paper's Fig. 10 order.
 MEASUREMENTS = {
@@ -84,6 +84,11 @@ MEASUREMENTS = {
 }
 #: The paper's 7 "visually important" measurements (its Table 4).
 IMPORTANT = ("B", "C", "D", "E", "F", "L", "P")
+
+#: The girths taken on one plane section (the others: the largest of several planes, or
+#: a limb's two sides), and the region each tape keeps to.
+SECTION_GIRTHS = ("B", "D", "E", "F")
+_SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs"}
 
 _UP = np.array([0.0, 0.0, 1.0])
 _SIDES = ("L", "R")
@@ -177,20 +182,35 @@ class Measurer:
         origins[:, 2] = heights
         return tape_lengths(vertices, self._edges[region], origins, _UP)
 
-    def neck_plane(self, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(1, 3) the neck circumference's point, (3,) its normal: midway between the
-        neck's base and top rings, perpendicular to the line joining them."""
-        base, top = self._ring(vertices, "neck_base"), self._ring(vertices, "neck_top")
-        return 0.5 * (base + top)[None], top - base
-
-    def neck_section(self, vertices: np.ndarray) -> np.ndarray:
-        """(n, 2) float64, metres: the points where the neck circumference's plane cuts
-        the neck (whose convex hull is the tape), across the body (the model's x, as a front
-        photo shows the neck) then front to back (as a side photo does); ``vertices``:
-        (V, 3) metres, rest A-pose."""
+    def girth_plane(self, vertices: np.ndarray, key: str) -> tuple[np.ndarray, np.ndarray]:
+        """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS``) and (3,) its
+        normal, on ``vertices`` (V, 3) metres, rest A-pose (or posed: the trunk and neck do
+        not move with the pose's four angles). The neck's: midway between the neck's base
+        and top rings, perpendicular to the line joining them; the trunk's: horizontal."""
         v = np.asarray(vertices, np.float64)
-        origin, normal = self.neck_plane(v)
-        return section_points(v, self._edges["neck"], origin[0], normal, np.array([1.0, 0, 0]))
+        if key == "B":
+            base, top = self._ring(v, "neck_base"), self._ring(v, "neck_top")
+            return 0.5 * (base + top), top - base
+        if key == "D":
+            height = self._point(v, "bust")[:, 2].mean()
+        elif key == "E":
+            height = self._point(v, "navel")[0, 2]
+        elif key == "F":
+            buttocks = v[self._buttock_vertices]
+            height = buttocks[np.argmax(buttocks[:, 1]), 2]
+        else:
+            raise KeyError(f"{key!r} is not one of {SECTION_GIRTHS}")
+        return np.array([0.0, 0.0, height]), _UP
+
+    def girth_section(self, vertices: np.ndarray, key: str) -> np.ndarray:
+        """(n, 2) float64, metres: the points where girth ``key``'s plane
+        (:meth:`girth_plane`) cuts its region (whose convex hull is the tape), across the
+        body (the model's x, as a front photo shows it) then front to back (as a side
+        photo does); ``vertices``: (V, 3) metres."""
+        v = np.asarray(vertices, np.float64)
+        origin, normal = self.girth_plane(v, key)
+        return section_points(v, self._edges[_SECTION_REGIONS[key]], origin, normal,
+                              np.array([1.0, 0, 0]))
 
     def measure(self, vertices: np.ndarray) -> dict[str, float]:
         """The 16 measurements of one body.
@@ -213,13 +233,10 @@ class Measurer:
         span = top - neck_top[2]
         out["A"] = np.nanmax(self._horizontal_girth(
             v, "skull", neck_top[2] + span * np.linspace(0.5, 0.8, 7)))
-        out["B"] = tape_lengths(v, self._edges["neck"], *self.neck_plane(v))[0]
+        for key in SECTION_GIRTHS:
+            out[key] = tape_lengths(v, self._edges[_SECTION_REGIONS[key]],
+                                    *self.girth_plane(v, key))[0]
         out["C"] = acromion[:, 2].mean() - crotch[2]
-        out["D"] = self._horizontal_girth(v, "trunk", self._point(v, "bust")[:, 2].mean())[0]
-        out["E"] = self._horizontal_girth(v, "trunk", self._point(v, "navel")[0, 2])[0]
-        buttocks = v[self._buttock_vertices]
-        out["F"] = self._horizontal_girth(v, "trunk_thighs",
-                                          buttocks[np.argmax(buttocks[:, 1]), 2])[0]
         out["G"] = self._limb_girths(v, "wrist", np.array([1.0]), np.nanmax)
         # midway between acromion and elbow: where that point projects onto the axis
         out["H"] = self._limb_girths(

@@ -66,11 +66,15 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+import warp
 from scipy import stats
+
+warp.config.log_level = warp.LOG_WARNING  # before bodyfit starts Warp: no banner in the Markdown
 
 from bodyfit.calib.images import write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.fitter.accuracy.bodies import KINDS, pose_bodies
+from bodyfit.fitter.accuracy.fit_photos import FitPhotos, answer_pose
 from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, errors_per_generation,
                                              fitted_rest_body)
 from bodyfit.fitter.accuracy.report import (failure_lines, important_table, mean_of_important,
@@ -79,21 +83,24 @@ from bodyfit.fitter.accuracy.scores import (IMPORTANT_COLUMNS, KEYS, TRUTHS_FILE
                                             error_stats, read_scores, truth_records)
 from bodyfit.fitter.batch.orchestration import BATCH_FILE
 from bodyfit.fitter.batch.tables import (FAILURES_COLUMNS, FAILURES_FILE, SUMMARY_COLUMNS,
-                                         SUMMARY_FILE, csv_text, read_table)
+                                         SUMMARY_FILE, SummaryRow, csv_text, read_table,
+                                         summary_row, write_tables)
 from bodyfit.fitter.accuracy.truth_costs import compare_costs
 from bodyfit.fitter.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
                                                  read_settings, read_truth, subject_ids,
                                                  write_bodies, write_photos_of_set)
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, project_shape, rest_shape
 from bodyfit.fitter.canvas import extreme_bodies
-from bodyfit.fitter.fit import stature_conditioner
+from bodyfit.fitter.fit import METHODS, stature_conditioner
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
-from bodyfit.fitter.outputs import write_text
+from bodyfit.fitter.outputs import write_fitted_measurements, write_text
+from bodyfit.fitter.photo_extents import PHOTO_EXTENTS, section_scales
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import read_run_config, run_config
 from bodyfit.fitter.sections import hull_perimeter
-from bodyfit.fitter.spreads import SpreadCalibration, bodyfit_calibration, recorded_answer_cost
+from bodyfit.fitter.spreads import (SpreadCalibration, bodyfit_calibration,
+                                    calibration_applies, recorded_answer_cost)
 from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
@@ -322,7 +329,7 @@ def _record_holders(runs: list[Path], subjects: list[str]) -> dict[str, Path]:
             for subject in own}
 
 
-def _budget_errors(model, bodies, run: Path, subjects: list[str],
+def _budget_errors(model, bodies, folder: Path, run: Path, subjects: list[str],
                    budgets: list[int]) -> np.ndarray:
     """(S, len(budgets), 7) |error| (mm) of the 7 important measurements of ``run``'s fits
     of ``subjects`` had each refinement run ``budgets`` generations (see :func:`budgets`)."""
@@ -334,7 +341,7 @@ def _budget_errors(model, bodies, run: Path, subjects: list[str],
     (generations, longest), = searches
     if max(budgets) > longest:
         sys.exit(f"{run}: its refinements ran {longest} generations, fewer than {max(budgets)}")
-    return errors_per_generation(model, bodies, run, [generations + g for g in budgets],
+    return errors_per_generation(model, bodies, folder, run, [generations + g for g in budgets],
                                  set(subjects))
 
 
@@ -345,10 +352,10 @@ def budgets(args) -> None:
     A refinement's first G generations do not depend on its budget (CMA-ES's state does not
     know it; the same seeds draw the same candidates), and run.json records the
     refinements' mean answer after every generation, so one run at the longest budget holds
-    every shorter one's answer on the same subjects (each stood to the stature as
-    ``figures`` stands it: the run's own error for the last generation). 0: the searches'
-    answer, before any refinement. Several runs are joined, each subject from the first
-    run holding it."""
+    every shorter one's answer on the same subjects (each measured as the fit measures its
+    answer, as ``figures`` measures it: the run's own error for the last generation). 0:
+    the searches' answer, before any refinement. Several runs are joined, each subject
+    from the first run holding it."""
     folder = Path(args.set)
     model = load_model()
     bodies = read_bodies(model, folder)
@@ -356,7 +363,7 @@ def budgets(args) -> None:
     parts = _joined([folder / "runs" / name for name in args.names], _fit_records(ids))
     if sum(len(own) for _, own in parts) < 2:
         sys.exit(f"{folder}: fewer than 2 subjects fitted by {', '.join(args.names)}")
-    errors = [_budget_errors(model, bodies, run, [s for s in ids if s in own],
+    errors = [_budget_errors(model, bodies, folder, run, [s for s in ids if s in own],
                              args.generations) for run, own in parts if own]
     errors = np.concatenate(errors)  # (S, G, 7)
     means = errors.mean(axis=2)
@@ -402,6 +409,59 @@ def keep(args) -> None:
         (kept / subject / "run.json").write_text(json.dumps(record, indent=1))
         shutil.copyfile(run / subject / "measurements.json", kept / subject / "measurements.json")
     print(f"{run} -> {kept}: {len(fitted)} fitted")
+
+
+def remeasure(args) -> None:
+    """Each fit of a run (a name or a kept folder, :func:`_run_folder`) measured again by
+    today's code, as `fitter run` measures its answer now
+    (:func:`bodyfit.fitter.fit.fitted_measurements`: the answer's body and the subject's
+    photos in the set), into the new run SET/runs/TO/: each record kept, measurements.json
+    and summary.csv written anew with the ± of today's calibration where it applies (the
+    run's own ± otherwise). A change of the measuring alone needs no fit again: the
+    search's answer does not depend on it."""
+    folder = Path(args.set)
+    source, out = _run_folder(folder, args.name), folder / "runs" / args.to
+    model = load_model()
+    measurer = Measurer.from_model(model)
+    previous = {row["id"]: row for row in read_table(source / SUMMARY_FILE, SUMMARY_COLUMNS)}
+    out.mkdir(parents=True, exist_ok=True)
+    for name in (BATCH_FILE, "bench.json"):
+        if (source / name).exists():
+            shutil.copyfile(source / name, out / name)
+    rows = [SummaryRow(subject, "failed earlier", reason=reason)
+            for subject, reason in read_scores(folder, source).failures]
+    for subject in read_scores(folder, source).ids:
+        record = json.loads((source / subject / "run.json").read_text())
+        photos = FitPhotos.of(model, folder, subject, record)
+        _, values, _ = photos.measure(model, measurer, np.array(record["result"]["betas"]),
+                                      answer_pose(record))
+        written = json.loads((source / subject / "measurements.json").read_text())
+        if calibration_applies(photos.settings, METHODS["bodyfit"]):
+            spreads = bodyfit_calibration().spreads(recorded_answer_cost(record))
+            basis = "calibrated"
+        else:
+            spreads = {key: written["measurements"][name]["spread_mm"]
+                       for key, (name, _) in MEASUREMENTS.items()}
+            basis = written.get("spread_basis", "population")
+        (out / subject).mkdir(exist_ok=True)
+        (out / subject / "run.json").write_text(json.dumps(record, indent=1))
+        write_fitted_measurements(out / subject / "measurements.json", values, spreads, basis,
+                                  written["provenance"] | {"remeasured_from": str(source)})
+        seconds = previous[subject]["seconds"]
+        rows.append(summary_row(out / subject, previous[subject]["status"],
+                                float(seconds) if seconds else None))
+        others = max(abs(values[key] - _old(written, key)) for key in MEASUREMENTS
+                     if key not in PHOTO_EXTENTS)
+        print(f"{subject}: " + ", ".join(f"{key} {values[key] - _old(written, key):+.1f} mm"
+                                         for key in PHOTO_EXTENTS)
+              + f"; the others as written to within {others:.2f} mm", flush=True)
+    write_tables(out, rows)
+    print(f"{source} -> {out}: {len(rows)} subjects")
+
+
+def _old(written: dict, key: str) -> float:
+    """A measurement's value (mm) in a measurements.json's payload ``written``."""
+    return written["measurements"][MEASUREMENTS[key][0]]["value_mm"]
 
 
 def _combinations(count: int) -> dict:
@@ -485,10 +545,11 @@ def combine(args) -> None:
         betas, pose = combined[:, :-len(POSE_NAMES)], combined[:, -len(POSE_NAMES):]
         if conditioner is not None:
             betas = conditioner.complete(betas[:, 1:], pose)
-        rest = rest_shape(model, betas)[0]
-        if conditioner is not None:
-            rest = scaled_to_stature(rest, stature_m)
-        measured = measurer.measure_many(rest) - np.array([truth[key] for key in KEYS])
+        photos = FitPhotos.of(model, folder, subject, record)
+        bodies_measured = [photos.measure(model, measurer, b, g) for b, g in zip(betas, pose)]
+        rest = [body for body, _, _ in bodies_measured]
+        measured = np.array([[values[key] - truth[key] for key in KEYS]
+                             for _, values, _ in bodies_measured])
         for name, values in zip(rules, measured):
             errors.setdefault(name, []).append(values)
         if not truncated:
@@ -499,8 +560,10 @@ def combine(args) -> None:
             rebuilt += 1
         scatter.append(measured[len(rules):].std(axis=0, ddof=1))  # the single answers'
         true_body = truths.vertices[ids.index(subject)]
-        true_neck = measurer.neck_section(true_body)
-        necks.append((true_neck, measurer.neck_section(rest[0]),
+        true_neck = measurer.girth_section(true_body, "B")
+        scale = (section_scales(model, measurer, bodies_measured[0][2])["B"]
+                 if bodies_measured[0][2] is not None else 1.0)
+        necks.append((true_neck, measurer.girth_section(rest[0], "B") * scale,
                       1000 * stature_m / settings.canvas.body_height_px,
                       _beyond_the_neck(measurer, true_body, true_neck)))
     fit = np.array(errors.get(FIT_RULE, []))
@@ -578,11 +641,11 @@ def spread(args) -> None:
 def _beyond_the_neck(measurer: Measurer, vertices: np.ndarray,
                      section: np.ndarray) -> np.ndarray:
     """(2,) mm: how much wider (x) and deeper (y) than its neck's ``section``
-    (``Measurer.neck_section``) the body ``vertices`` (V, 3, rest) is at the height of the
+    (``Measurer.girth_section``) the body ``vertices`` (V, 3, rest) is at the height of the
     neck tape's centre, within 12 cm of it across (no arm): what of the front and side
     outlines there is another part (the jaw, the chin) than the neck."""
     v = np.asarray(vertices, np.float64)
-    centre = measurer.neck_plane(v)[0][0]
+    centre = measurer.girth_plane(v, "B")[0]
     near = (np.abs(v[:, 2] - centre[2]) < 0.003) & (np.abs(v[:, 0] - centre[0]) < 0.12)
     return 1000 * (np.ptp(v[near, :2], axis=0) - np.ptp(section, axis=0))
 
@@ -595,7 +658,7 @@ def _neck_line(necks: list[tuple[np.ndarray, np.ndarray, float, np.ndarray]]) ->
     extents alone give); and on how many the truth's outlines show the neck at the tape's
     centre height (:func:`_beyond_the_neck` under 1 mm). ``necks``: (truth's section,
     fit's section, canvas mm per pixel, :func:`_beyond_the_neck` of the truth) per
-    subject, sections (n, 2) metres (``Measurer.neck_section``)."""
+    subject, sections (n, 2) metres (``Measurer.girth_section``)."""
     rows = []
     for truth, fitted, pixel_mm, _ in necks:
         true_size, fit_size = np.ptp(truth, axis=0), np.ptp(fitted, axis=0)
@@ -679,7 +742,7 @@ def report(args) -> None:
     ablations = [_run_spec(spec) for spec in args.ablation]
     table4 = {}
     for label, set_folder, runs in mains:
-        scores, timing = _run_scores(set_folder, runs, args.first)
+        scores, timing = _run_scores(set_folder, runs, args.first, args.skip)
         table4[label] = scores
         print(f"### {label}\n\n{timing}.\n")
         print("\n".join(measurement_table(scores)) + "\n")
@@ -695,7 +758,7 @@ def report(args) -> None:
         baseline = first_of_set.setdefault(set_folder.resolve(), label)
         if baseline != label:
             baselines[label] = baseline
-        scores, timing = _run_scores(set_folder, runs, args.first)
+        scores, timing = _run_scores(set_folder, runs, args.first, args.skip)
         table4[label] = scores
         print(f"- {label}: {timing}")
     print("\n### The 7 important measurements (Table 4 form)\n")
@@ -737,7 +800,7 @@ def figures(args) -> None:
     common = {s for s in ids if all((run / s / "run.json").exists() for run in runs.values())}
     curves = {}
     for label, run in runs.items():
-        curves[label] = errors_per_generation(model, bodies, run, generations,
+        curves[label] = errors_per_generation(model, bodies, folder, run, generations,
                                               common).mean(axis=(0, 2))
         print(f"{label}: " + ", ".join(f"g{g} {e:.1f}" for g, e in zip(generations,
                                                                       curves[label])))
@@ -808,6 +871,11 @@ def main() -> None:
     p.add_argument("name", help="the run's name (SET/runs/NAME)")
     p.add_argument("--to", default="docs/accuracy-runs",
                    help="folder of kept runs: TO/<set kind>/NAME/ (default: %(default)s)")
+    p = sub.add_parser("remeasure", help="a run's fits measured again by today's code, "
+                       "into a new run")
+    p.add_argument("set")
+    p.add_argument("name", help="the run's name (SET/runs/NAME) or a kept run's folder")
+    p.add_argument("to", help="the new run's name (SET/runs/TO)")
     p = _joined_runs_parser(sub, "combine", "other ways to combine the answers a run's fits "
                             "averaged")
     p.add_argument("--answers", type=int, metavar="N",
@@ -828,6 +896,9 @@ def main() -> None:
                    help="a run in the Table 4 form only")
     p.add_argument("--first", type=int, help="every row over its set's first N subjects "
                    "only (compare runs of `fit --first N` with a full run)")
+    p.add_argument("--skip", type=int, default=0, metavar="I",
+                   help="with --first N: rows I to N - 1 only (e.g. subjects fitted after "
+                   "a choice made on the others)")
     p.add_argument("--per-measurement", action="store_true",
                    help="also each ablation against its set's first, measurement by "
                    "measurement, over the subjects both fitted")
@@ -870,7 +941,7 @@ def main() -> None:
     else:
         {"make": make, "keep": keep, "combine": combine, "report": report,
          "outlines": outlines, "floor": floor, "costs": costs, "budgets": budgets,
-         "figures": figures, "spread": spread}[args.command](args)
+         "figures": figures, "spread": spread, "remeasure": remeasure}[args.command](args)
 
 
 if __name__ == "__main__":

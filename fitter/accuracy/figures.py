@@ -17,6 +17,7 @@ import numpy as np
 
 from bodyfit.fitter.accuracy.scores import IMPORTANT_COLUMNS, KEYS
 from bodyfit.fitter.accuracy.bodies import Bodies
+from bodyfit.fitter.accuracy.fit_photos import FitPhotos, answer_pose
 from bodyfit.fitter.accuracy.subject_set import subject_ids
 from bodyfit.fitter.body_model import BodyModel, rest_shape
 from bodyfit.fitter.measurements import Measurer
@@ -26,26 +27,23 @@ from bodyfit.fitter.render import render_colours
 __all__ = ["errors_per_generation", "distance_panel", "colour_bar", "fitted_rest_body"]
 
 
-def _rest_bodies(model: BodyModel, run_folder: Path, subject: str,
-                 generations: list[int] | None = None) -> np.ndarray:
-    """(G, V, 3) the rest body answered after each of ``generations`` (1-based; None:
-    the last), as the fit measures it: stood as tall as the person when the run solved
-    every candidate to the stature (``fitter.fit.fit_person``)."""
+def _answers(run_folder: Path, subject: str,
+             generations: list[int] | None = None) -> tuple[dict, np.ndarray]:
+    """(the fit's run.json payload, (G, K) the betas answered after each of
+    ``generations`` (1-based; None: the last))."""
     record = json.loads((Path(run_folder) / subject / "run.json").read_text())
     betas = np.array(record["result"]["best_betas_per_generation"], np.float32)
-    picked = betas[np.minimum(generations or [len(betas)], len(betas)) - 1]
-    rest = rest_shape(model, picked)[0]
-    if record["settings"]["search"]["condition_stature"]:
-        stature_m = record["inputs"]["height_cm"] / 100.0
-        rest = scaled_to_stature(rest, stature_m)
-    return rest
+    return record, betas[np.minimum(generations or [len(betas)], len(betas)) - 1]
 
 
-def errors_per_generation(model: BodyModel, bodies: Bodies, run_folder: Path,
-                          generations: list[int], subjects: set[str]) -> np.ndarray:
+def errors_per_generation(model: BodyModel, bodies: Bodies, set_folder: Path,
+                          run_folder: Path, generations: list[int],
+                          subjects: set[str]) -> np.ndarray:
     """(S, len(generations), 7) |error| (mm) of the 7 important measurements of the body
     answered after each of ``generations`` (1-based), for the S ``subjects`` (ids whose
-    run.json the run has) in the set's order; ``bodies``: the set's
+    run.json the run has) in the set's order, each measured as the fit measures its
+    answer (:class:`.fit_photos.FitPhotos`: the subject's photos in ``set_folder``; the
+    answer's angles, which the run records for its end only); ``bodies``: the set's
     (:func:`.subject_set.read_bodies`); the last generation's is the run's own error."""
     measurer = Measurer.from_model(model)
     errors = []
@@ -53,17 +51,25 @@ def errors_per_generation(model: BodyModel, bodies: Bodies, run_folder: Path,
         if subject not in subjects:
             continue
         truth = measurer.measure(bodies.vertices[index])
+        record, betas = _answers(run_folder, subject, generations)
+        photos = FitPhotos.of(model, set_folder, subject, record)
         rows = []
-        for vertices in _rest_bodies(model, run_folder, subject, generations):
-            measured = measurer.measure(vertices)
+        for answer in betas:
+            measured = photos.measure(model, measurer, answer, answer_pose(record))[1]
             rows.append([abs(measured[KEYS[j]] - truth[KEYS[j]]) for j in IMPORTANT_COLUMNS])
         errors.append(rows)
     return np.array(errors)
 
 
 def fitted_rest_body(model: BodyModel, run_folder: Path, subject: str) -> np.ndarray:
-    """(V, 3) the fitted rest body of ``subject`` (the last generation's best)."""
-    return _rest_bodies(model, run_folder, subject)[0]
+    """(V, 3) the fitted rest body of ``subject`` (the last generation's best), as the fit
+    measures it: stood as tall as the person when the run solved every candidate to the
+    stature (``fitter.fit.fit_person``)."""
+    record, betas = _answers(run_folder, subject)
+    rest = rest_shape(model, betas)[0]
+    if record["settings"]["search"]["condition_stature"]:
+        rest = scaled_to_stature(rest, record["inputs"]["height_cm"] / 100.0)
+    return rest[0]
 
 
 def distance_panel(model: BodyModel, truth: np.ndarray, fitted: list[np.ndarray],

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from bodyfit.fitter.cli import main
-from bodyfit.fitter.mesh_io import write_mesh
+from bodyfit.fitter.mesh_io import read_mesh, write_mesh
+from bodyfit.fitter.photo_extents import MAX_CHANGE, PHOTO_EXTENTS
 
 
 def run(capsys, *argv):
@@ -68,6 +69,14 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     fitted = {row["letter"]: row["value_mm"] for row in written["measurements"].values()}
     spreads = {row["letter"]: row["spread_mm"] for row in written["measurements"].values()}
     assert abs(fitted["O"] - truth["O"]) < 15.0
+    # the mesh's measurements but for the girths scaled to the photos, which move by less
+    # than their bound (photo_extents: the fit's pinhole views take them)
+    mesh = measurer.measure(read_mesh(out_dir / "fit" / "mesh_rest.ply", body_model.faces))
+    for key in MEASUREMENTS:
+        if key in PHOTO_EXTENTS:
+            assert abs(fitted[key] / mesh[key] - 1) < MAX_CHANGE, key
+        else:
+            assert fitted[key] == pytest.approx(mesh[key], abs=0.01), key
     # the printed table: 16 rows of fitted, ±, true and error, then the important ones'
     # mean; the ±'s kind named (3 generations are not the default method: the population's)
     rows = re.findall(r"^  ([A-P]) .+? +(-?\d+\.\d) +(\d+\.\d) +(-?\d+\.\d) +([+-]\d+\.\d)$",

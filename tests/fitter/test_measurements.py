@@ -6,7 +6,7 @@ import trimesh
 from scipy.spatial import ConvexHull
 
 from bodyfit.fitter.anny_source import SHAPE_PARAMETERS
-from bodyfit.fitter.measurements import MEASUREMENTS
+from bodyfit.fitter.measurements import MEASUREMENTS, SECTION_GIRTHS
 from bodyfit.fitter.population_sampler import SEXES, ReferenceStats
 from bodyfit.fitter.sections import hull_perimeter, mesh_edges, section_points, tape_lengths
 
@@ -92,13 +92,14 @@ def test_stature_is_the_mesh_height_and_translation_does_not_matter(body_model, 
         assert shifted[key] == pytest.approx(got[key], abs=1e-3), key
 
 
-def test_neck_section_is_the_neck_tape(measurer, body_model):
-    """The neck section's hull is the neck circumference (B); a body twice as wide has a
-    section twice as wide and as deep as before."""
+@pytest.mark.parametrize("key", SECTION_GIRTHS)
+def test_girth_section_is_the_tape(measurer, body_model, key):
+    """Each one-plane girth's section's hull is its circumference; a body twice as wide has
+    a section twice as wide and as deep as before."""
     v = body_model.mean_vertices.astype(np.float64)
-    points = measurer.neck_section(v)
-    assert hull_perimeter(points) * 1000 == pytest.approx(measurer.measure(v)["B"], rel=1e-6)
-    wide = measurer.neck_section(v * [2.0, 1.0, 1.0])
+    points = measurer.girth_section(v, key)
+    assert hull_perimeter(points) * 1000 == pytest.approx(measurer.measure(v)[key], rel=1e-6)
+    wide = measurer.girth_section(v * [2.0, 1.0, 1.0], key)
     assert np.ptp(wide[:, 0]) == pytest.approx(2 * np.ptp(points[:, 0]), rel=1e-5)
     assert np.ptp(wide[:, 1]) == pytest.approx(np.ptp(points[:, 1]), rel=1e-5)
 

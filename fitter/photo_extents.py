@@ -1,0 +1,195 @@
+"""Girths scaled to the extents the photos show at the tape's height.
+
+The silhouette fit places each outline of the body to about a canvas pixel (at 600 px a
+pixel is the stature over 600, some 3 mm), and where the model cannot follow the person
+everywhere at once it compromises: out-of-space the neck's section came out 2.7 mm too
+wide or narrow on average, its circumference 7.9 mm off (docs/accuracy.md, "Pushing the
+numbers", steps 26 and 28). The photo itself shows that width at its own resolution. So
+for the girths of :data:`PHOTO_EXTENTS`, after the fit, each listed view's photo is
+compared with the fitted body rendered through the same camera at the photo's resolution:
+the ratio of the person's outline width to the body's, averaged over the rows around the
+tape's centre, scales the fitted section along that view's axis (the front view's across
+the body, the side view's front to back), and the tape is the scaled section's convex hull.
+
+- The camera is placed from the fitted body in the view's pose (as the search places it:
+  :func:`~bodyfit.fitter.pinhole_canvas.solve_placement`), so the body's crown and toes
+  fall on the silhouette's top and bottom rows and the tape's rows are the person's.
+- A width is the foreground run of a photo row that holds the projected section's centre
+  (or lies nearest it), in the person's mask and in the body's render alike; only the
+  band of rows around the tape is rendered (a crop of the camera), so photos of any size
+  cost the same.
+- The scaling is skipped (the fitted girth kept) where the rendered body's outline at
+  those rows is not the girth's own part (an arm against the chest, the jaw over the
+  neck), where the person's outline reaches into another part of the rendered body (the
+  person's arm touches the chest where the body's does not), or where the ratio strays
+  beyond :data:`MAX_CHANGE` (hair or clothing, not the body, makes that outline).
+- Which girths and views: chosen by measured error (docs/accuracy.md step 28): the
+  neck's, the chest's, the waist's and the hip's width from the front photo. The side
+  photo's depths lost in-space (the neck's side outline at the tape is the chin's, the
+  hip's holds the hands); the limbs' girths are not scaled.
+
+Pinhole views only (the photos' own camera); the paper's orthographic method measures
+the fitted mesh alone.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from bodyfit import kernels
+from bodyfit.fitter.body_model import PART_NAMES, BodyModel
+from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.pinhole_canvas import solve_placement
+from bodyfit.fitter.sections import hull_perimeter
+from bodyfit.kernels.target import visible_vertices
+
+__all__ = ["PHOTO_EXTENTS", "MAX_CHANGE", "ViewPhoto", "outline_width", "extent_ratio",
+           "section_scales", "photo_scaled_girths"]
+
+#: girth key -> the views whose photo sets its section's extent ("front": across the
+#: body, the section's first axis; "side": front to back, its second).
+PHOTO_EXTENTS = {"B": ("front",), "D": ("front",), "E": ("front",), "F": ("front",)}
+#: The largest relative change of an extent the photos may make.
+MAX_CHANGE = 0.2
+#: Each girth's own parts: the rendered outline at the tape's rows must be of these.
+_GIRTH_PARTS = {"B": ("neck",), "D": ("chest",), "E": ("waist",), "F": ("hip", "leg")}
+_BAND_ROWS = 2  # rows above and below the tape's centre row
+_SUBPIXELS = 4  # the body's render cuts each photo column into as many
+_MARGIN_PX = 8
+_AXES = {"front": 0, "side": 1}
+
+
+@dataclasses.dataclass(frozen=True)
+class ViewPhoto:
+    """One photo and the fitted body as its view renders it.
+
+    Attributes:
+        name: "front" or "side".
+        mask: (H, W) bool, the person's silhouette in the undistorted, upright photo.
+        intrinsics: (3, 3) K of that photo, pixels.
+        body: (V, 3) float metres, model frame: the fitted body in the view's pose (the
+            side view's arms hanging down), at any scale (the placement follows it).
+        visible_parts: the part names the view renders (its camera is placed from them).
+    """
+
+    name: str
+    mask: np.ndarray
+    intrinsics: np.ndarray
+    body: np.ndarray
+    visible_parts: tuple[str, ...]
+
+
+def _runs(row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(first columns, last columns) of the foreground runs of the (W,) bool ``row``."""
+    cols = np.flatnonzero(row)
+    if len(cols) == 0:
+        return cols, cols
+    gaps = np.flatnonzero(np.diff(cols) > 1)
+    return np.r_[cols[0], cols[gaps + 1]], np.r_[cols[gaps], cols[-1]]
+
+
+def outline_width(row: np.ndarray, column: float) -> tuple[int, int]:
+    """(first, last) column of the foreground run of the (W,) bool ``row`` that holds
+    ``column`` or, if none does, lies nearest it; (0, -1) for an empty row."""
+    starts, ends = _runs(row)
+    if len(starts) == 0:
+        return 0, -1
+    distance = np.maximum(np.maximum(starts - column, column - ends), 0)
+    i = int(np.argmin(distance))
+    return int(starts[i]), int(ends[i])
+
+
+def _meets_another_run(row: np.ndarray, run: tuple[int, int], other: tuple[int, int]) -> bool:
+    """Whether the columns ``other`` (first, last) reach into a foreground run of the
+    (W,) bool ``row`` other than ``run``."""
+    starts, ends = _runs(row)
+    apart = (starts != run[0]) & (ends >= other[0]) & (starts <= other[1])
+    return bool(apart.any())
+
+
+def _band_render(model: BodyModel, photo: ViewPhoto, rotation, translation, rows: range,
+                 columns: range) -> np.ndarray:
+    """(len(rows), len(columns) * _SUBPIXELS) int8 part labels (-1: background) of the
+    body rendered through the photo's camera, in that crop of the photo, each pixel cut
+    into ``_SUBPIXELS`` columns (photo column c covers sub-columns s c .. s c + s - 1)."""
+    s = _SUBPIXELS
+    k = np.asarray(photo.intrinsics, float).copy()
+    k[0] *= s  # column u' = s (u + 1/2) - 1/2 of the photo's column u, over the crop
+    k[0, 2] += (s - 1) / 2 - s * columns.start
+    k[1, 2] -= rows.start
+    camera = kernels.pinhole_camera(k, rotation, translation)
+    return kernels.rasterize(photo.body[None].astype(np.float32), model.faces,
+                             model.face_parts, camera, len(rows), len(columns) * s).numpy()[0]
+
+
+def extent_ratio(model: BodyModel, measurer: Measurer, key: str,
+                 photo: ViewPhoto) -> float | None:
+    """The person's outline width over the fitted body's at girth ``key``'s tape in the
+    view's photo (module docstring); None where the rendered outline there is not the
+    girth's own part, or the ratio strays beyond :data:`MAX_CHANGE`."""
+    body = np.asarray(photo.body, np.float64)
+    shown = visible_vertices(model.vertex_parts, photo.visible_parts)
+    k = np.asarray(photo.intrinsics, float)
+    placement = solve_placement(photo.name, photo.mask, k, body[shown])
+    rotation, translation = placement.extrinsics(photo.name)
+    origin, normal = measurer.girth_plane(body, key)
+    section = measurer.girth_section(body, key)
+    # the section's centre, back in the model frame (section_points' frame: across = x
+    # in the plane, then normal x across; origin = the plane's point nearest the origin)
+    n = normal / np.linalg.norm(normal)
+    across = np.array([1.0, 0, 0]) - n[0] * n
+    across /= np.linalg.norm(across)
+    centre = (origin @ n) * n + section.mean(axis=0) @ np.stack([across, np.cross(n, across)])
+    cam = rotation @ centre + translation
+    u, v = (k[:2, :2] @ (cam[:2] / cam[2])) + k[:2, 2]
+    height, width = photo.mask.shape
+    row = int(round(v))
+    if not _BAND_ROWS <= row < height - _BAND_ROWS:
+        return None
+    rows = range(row - _BAND_ROWS, row + _BAND_ROWS + 1)
+    mask_cols = np.flatnonzero(photo.mask[rows.start:rows.stop].any(axis=0))
+    if len(mask_cols) == 0:
+        return None
+    columns = range(max(0, mask_cols[0] - _MARGIN_PX), min(width, mask_cols[-1] + _MARGIN_PX + 1))
+    labels = _band_render(model, photo, rotation, translation, rows, columns)
+    own = [PART_NAMES.index(p) for p in _GIRTH_PARTS[key]]
+    person, fitted = [], []
+    s = _SUBPIXELS
+    for i, r in enumerate(rows):
+        body = labels[i] >= 0
+        run = outline_width(body, s * (u - columns.start + 0.5) - 0.5)
+        if run[1] < run[0] or labels[i, run[0]] not in own or labels[i, run[1]] not in own:
+            return None
+        first, last = outline_width(photo.mask[r, columns.start:columns.stop], u - columns.start)
+        if _meets_another_run(body, run, (s * first, s * last + s - 1)):
+            return None  # the person's outline there holds more (an arm against the chest)
+        fitted.append((run[1] - run[0] + 1) / s)
+        person.append(last - first + 1)
+    ratio = float(np.mean(person) / np.mean(fitted))
+    return ratio if abs(ratio - 1.0) <= MAX_CHANGE else None
+
+
+def section_scales(model: BodyModel, measurer: Measurer,
+                   photos: dict[str, ViewPhoto]) -> dict[str, np.ndarray]:
+    """key -> (2,) the factors of the girths of :data:`PHOTO_EXTENTS` on their sections'
+    extents (across the body, front to back): each the :func:`extent_ratio` of its
+    view's photo in ``photos``, 1 where none applies."""
+    scales = {}
+    for key, views in PHOTO_EXTENTS.items():
+        scales[key] = np.ones(2)
+        for name in views:
+            ratio = extent_ratio(model, measurer, key, photos[name])
+            if ratio is not None:
+                scales[key][_AXES[name]] = ratio
+    return scales
+
+
+def photo_scaled_girths(model: BodyModel, measurer: Measurer, rest: np.ndarray,
+                        photos: dict[str, ViewPhoto]) -> dict[str, float]:
+    """key -> mm: the girths of :data:`PHOTO_EXTENTS` of the fitted body ``rest`` (V, 3)
+    metres (rest A-pose, at the person's stature), each its section scaled by its
+    :func:`section_scales` (a girth no ratio applies to keeps its fitted value)."""
+    return {key: 1000.0 * hull_perimeter(measurer.girth_section(rest, key) * scale)
+            for key, scale in section_scales(model, measurer, photos).items()}
