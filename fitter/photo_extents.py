@@ -128,7 +128,8 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str,
                  photo: ViewPhoto) -> float | None:
     """The person's outline width over the fitted body's at girth ``key``'s tape in the
     view's photo (module docstring); None where the rendered outline there is not the
-    girth's own part, or the ratio strays beyond :data:`MAX_CHANGE`."""
+    girth's own part, where the person's outline reaches into another run of the render,
+    or where the ratio strays beyond :data:`MAX_CHANGE`."""
     body = np.asarray(photo.body, np.float64)
     shown = visible_vertices(model.vertex_parts, photo.visible_parts)
     k = np.asarray(photo.intrinsics, float)
@@ -158,12 +159,12 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str,
     person, fitted = [], []
     s = _SUBPIXELS
     for i, r in enumerate(rows):
-        body = labels[i] >= 0
-        run = outline_width(body, s * (u - columns.start + 0.5) - 0.5)
+        rendered = labels[i] >= 0
+        run = outline_width(rendered, s * (u - columns.start + 0.5) - 0.5)
         if run[1] < run[0] or labels[i, run[0]] not in own or labels[i, run[1]] not in own:
             return None
         first, last = outline_width(photo.mask[r, columns.start:columns.stop], u - columns.start)
-        if _meets_another_run(body, run, (s * first, s * last + s - 1)):
+        if _meets_another_run(rendered, run, (s * first, s * last + s - 1)):
             return None  # the person's outline there holds more (an arm against the chest)
         fitted.append((run[1] - run[0] + 1) / s)
         person.append(last - first + 1)

@@ -7,6 +7,7 @@ their truth.
   uneven light, sensor noise and JPEG;
 - :mod:`.subject_set`: a set of subjects on disk (photos, truth, board photos, the
   subjects table of ``fitter batch``);
+- :mod:`.fit_photos`: a subject's fit as `fitter run` saw it, to measure its bodies again;
 - :mod:`.scores`: errors against the truth and their statistics;
 - :mod:`.report`: the Markdown tables (the paper's Tables 3 and 4 and more).
 
