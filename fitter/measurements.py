@@ -59,7 +59,8 @@ import dataclasses
 import numpy as np
 
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
-from bodyfit.fitter.sections import mesh_edges, region_edges, section_points, tape_lengths
+from bodyfit.fitter.sections import (mesh_edges, region_edges, section_centre,
+                                     section_points, tape_lengths)
 
 __all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "Measurer"]
 
@@ -211,6 +212,12 @@ class Measurer:
         origin, normal = self.girth_plane(v, key)
         return section_points(v, self._edges[_SECTION_REGIONS[key]], origin, normal,
                               np.array([1.0, 0, 0]))
+
+    def girth_centre(self, vertices: np.ndarray, key: str) -> np.ndarray:
+        """(3,) float64, metres: the mean of girth ``key``'s section points
+        (:meth:`girth_section`) in the body's frame; ``vertices``: (V, 3) metres."""
+        v = np.asarray(vertices, np.float64)
+        return section_centre(v, self._edges[_SECTION_REGIONS[key]], *self.girth_plane(v, key))
 
     def measure(self, vertices: np.ndarray) -> dict[str, float]:
         """The 16 measurements of one body.

@@ -45,8 +45,8 @@ from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["PHOTO_EXTENTS", "MAX_CHANGE", "ViewPhoto", "outline_width", "extent_ratio",
-           "section_scales", "photo_scaled_girths"]
+__all__ = ["PHOTO_EXTENTS", "MAX_CHANGE", "ViewPhoto", "outline_width", "placed_camera",
+           "extent_ratio", "section_scales", "photo_scaled_girths"]
 
 #: girth key -> the views whose photo sets its section's extent ("front": across the
 #: body, the section's first axis; "side": front to back, its second).
@@ -109,6 +109,15 @@ def _meets_another_run(row: np.ndarray, run: tuple[int, int], other: tuple[int, 
     return bool(apart.any())
 
 
+def placed_camera(model: BodyModel, photo: ViewPhoto) -> tuple[np.ndarray, np.ndarray]:
+    """(R (3, 3), t (3,) metres): the photo's camera placed from its fitted body
+    (:func:`~bodyfit.fitter.pinhole_canvas.solve_placement` on the parts the view shows)."""
+    shown = visible_vertices(model.vertex_parts, photo.visible_parts)
+    placement = solve_placement(photo.name, photo.mask, np.asarray(photo.intrinsics, float),
+                                np.asarray(photo.body, np.float64)[shown])
+    return placement.extrinsics(photo.name)
+
+
 def _band_render(model: BodyModel, photo: ViewPhoto, rotation, translation, rows: range,
                  columns: range) -> np.ndarray:
     """(len(rows), len(columns) * _SUBPIXELS) int8 part labels (-1: background) of the
@@ -124,26 +133,16 @@ def _band_render(model: BodyModel, photo: ViewPhoto, rotation, translation, rows
                              model.face_parts, camera, len(rows), len(columns) * s).numpy()[0]
 
 
-def extent_ratio(model: BodyModel, measurer: Measurer, key: str,
-                 photo: ViewPhoto) -> float | None:
+def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhoto,
+                 camera: tuple[np.ndarray, np.ndarray]) -> float | None:
     """The person's outline width over the fitted body's at girth ``key``'s tape in the
-    view's photo (module docstring); None where the rendered outline there is not the
-    girth's own part, where the person's outline reaches into another run of the render,
-    or where the ratio strays beyond :data:`MAX_CHANGE`."""
-    body = np.asarray(photo.body, np.float64)
-    shown = visible_vertices(model.vertex_parts, photo.visible_parts)
+    view's photo (module docstring), the photo's camera (R, t) placed by
+    :func:`placed_camera`; None where the rendered outline there is not the girth's own
+    part, where the person's outline reaches into another run of the render, or where
+    the ratio strays beyond :data:`MAX_CHANGE`."""
+    rotation, translation = camera
     k = np.asarray(photo.intrinsics, float)
-    placement = solve_placement(photo.name, photo.mask, k, body[shown])
-    rotation, translation = placement.extrinsics(photo.name)
-    origin, normal = measurer.girth_plane(body, key)
-    section = measurer.girth_section(body, key)
-    # the section's centre, back in the model frame (section_points' frame: across = x
-    # in the plane, then normal x across; origin = the plane's point nearest the origin)
-    n = normal / np.linalg.norm(normal)
-    across = np.array([1.0, 0, 0]) - n[0] * n
-    across /= np.linalg.norm(across)
-    centre = (origin @ n) * n + section.mean(axis=0) @ np.stack([across, np.cross(n, across)])
-    cam = rotation @ centre + translation
+    cam = rotation @ measurer.girth_centre(photo.body, key) + translation
     u, v = (k[:2, :2] @ (cam[:2] / cam[2])) + k[:2, 2]
     height, width = photo.mask.shape
     row = int(round(v))
@@ -176,12 +175,14 @@ def section_scales(model: BodyModel, measurer: Measurer,
                    photos: dict[str, ViewPhoto]) -> dict[str, np.ndarray]:
     """key -> (2,) the factors of the girths of :data:`PHOTO_EXTENTS` on their sections'
     extents (across the body, front to back): each the :func:`extent_ratio` of its
-    view's photo in ``photos``, 1 where none applies."""
+    view's photo in ``photos``, 1 where none applies; each view's camera placed once."""
+    cameras = {name: placed_camera(model, photos[name])
+               for name in {view for views in PHOTO_EXTENTS.values() for view in views}}
     scales = {}
     for key, views in PHOTO_EXTENTS.items():
         scales[key] = np.ones(2)
         for name in views:
-            ratio = extent_ratio(model, measurer, key, photos[name])
+            ratio = extent_ratio(model, measurer, key, photos[name], cameras[name])
             if ratio is not None:
                 scales[key][_AXES[name]] = ratio
     return scales

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 __all__ = ["mesh_edges", "region_edges", "plane_basis", "hull_perimeter", "tape_lengths",
-           "section_points"]
+           "section_points", "section_centre"]
 
 
 def mesh_edges(faces: np.ndarray) -> np.ndarray:
@@ -118,3 +118,15 @@ def section_points(vertices: np.ndarray, edges: np.ndarray, origin: np.ndarray,
     frame = np.stack([first, np.cross(n, first)])
     points = _sections(vertices, edges, np.atleast_2d(np.asarray(origin, np.float64)), n)[0]
     return points @ plane_basis(n) @ frame.T
+
+
+def section_centre(vertices: np.ndarray, edges: np.ndarray, origin: np.ndarray,
+                   normal: np.ndarray) -> np.ndarray:
+    """(3,) float64, metres: the mean of the points where one plane (through ``origin``
+    (3,), of ``normal`` (3,)) cuts the ``edges`` (E, 2) of a mesh with ``vertices`` (V, 3),
+    in the mesh's frame."""
+    n = np.asarray(normal, np.float64)
+    n = n / np.linalg.norm(n)
+    origin = np.asarray(origin, np.float64)
+    points = _sections(vertices, edges, origin[None], n)[0]
+    return (origin @ n) * n + points.mean(axis=0) @ plane_basis(n)

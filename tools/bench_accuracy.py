@@ -69,8 +69,6 @@ import numpy as np
 import warp
 from scipy import stats
 
-warp.config.log_level = warp.LOG_WARNING  # before bodyfit starts Warp: no banner in the Markdown
-
 from bodyfit.calib.images import write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.fitter.accuracy.bodies import KINDS, pose_bodies
@@ -428,9 +426,10 @@ def remeasure(args) -> None:
     for name in (BATCH_FILE, "bench.json"):
         if (source / name).exists():
             shutil.copyfile(source / name, out / name)
+    scores = read_scores(folder, source)
     rows = [SummaryRow(subject, "failed earlier", reason=reason)
-            for subject, reason in read_scores(folder, source).failures]
-    for subject in read_scores(folder, source).ids:
+            for subject, reason in scores.failures]
+    for subject in scores.ids:
         record = json.loads((source / subject / "run.json").read_text())
         photos = FitPhotos.of(model, folder, subject, record)
         _, values, _ = photos.measure(model, measurer, np.array(record["result"]["betas"]),
@@ -844,6 +843,7 @@ def _joined_runs_parser(sub, command: str, description: str) -> argparse.Argumen
 
 
 def main() -> None:
+    warp.config.log_level = warp.LOG_WARNING  # no initialisation banner in the Markdown
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("make", help="draw and photograph a subject set")

@@ -8,7 +8,8 @@ from scipy.spatial import ConvexHull
 from bodyfit.fitter.anny_source import SHAPE_PARAMETERS
 from bodyfit.fitter.measurements import MEASUREMENTS, SECTION_GIRTHS
 from bodyfit.fitter.population_sampler import SEXES, ReferenceStats
-from bodyfit.fitter.sections import hull_perimeter, mesh_edges, section_points, tape_lengths
+from bodyfit.fitter.sections import (hull_perimeter, mesh_edges, section_centre,
+                                     section_points, tape_lengths)
 
 KEYS = list(MEASUREMENTS)
 
@@ -46,6 +47,17 @@ def test_section_of_a_tilted_plane_is_turned_across_the_body():
     assert np.ptp(points[:, 1]) == pytest.approx(0.10 / np.cos(tilt), rel=1e-5)
     assert hull_perimeter(points) == pytest.approx(
         ellipse_perimeter(0.08, 0.05 / np.cos(tilt)), rel=2e-5)
+
+
+def test_section_centre_of_a_tilted_plane_is_on_the_cylinders_axis():
+    """A plane tilted about the x axis through (0, 0, 0.3) cuts a cylinder standing on
+    (0.4, -0.2) where the axis meets it: at (0.4, -0.2, 0.3 + 0.2 tan(tilt))."""
+    cyl = trimesh.creation.cylinder(radius=0.06, height=2.0, sections=720)
+    vertices = cyl.vertices + [0.4, -0.2, 0.0]
+    tilt = np.deg2rad(25)
+    centre = section_centre(vertices, mesh_edges(cyl.faces), [0.0, 0.0, 0.3],
+                            [0.0, np.sin(tilt), np.cos(tilt)])
+    np.testing.assert_allclose(centre, [0.4, -0.2, 0.3 + 0.2 * np.tan(tilt)], atol=1e-5)
 
 
 def test_tape_bridges_concavities_of_an_l_shaped_prism():

@@ -7,7 +7,7 @@ import pytest
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
 from bodyfit.fitter.photo_extents import (MAX_CHANGE, ViewPhoto, extent_ratio,
-                                          outline_width, photo_scaled_girths)
+                                          outline_width, photo_scaled_girths, placed_camera)
 from bodyfit.fitter.pinhole_canvas import Placement
 
 PHOTO_SHAPE = (1600, 1200)
@@ -93,6 +93,8 @@ def test_a_person_whose_arms_touch_the_chest_keeps_the_fitted_chest(body_model, 
         if len(gaps):
             row[cols[gaps[0]]:cols[gaps[0] + 1]] = True
     apart = ViewPhoto("front", person, K, posed, PART_NAMES)
-    assert extent_ratio(body_model, measurer, "D", apart) == pytest.approx(1, abs=0.01)
+    camera = placed_camera(body_model, apart)
+    assert extent_ratio(body_model, measurer, "D", apart, camera) == pytest.approx(1, abs=0.01)
     touching = ViewPhoto("front", joined, K, posed, PART_NAMES)
-    assert extent_ratio(body_model, measurer, "D", touching) is None
+    assert extent_ratio(body_model, measurer, "D", touching,
+                        placed_camera(body_model, touching)) is None
