@@ -59,7 +59,7 @@ import dataclasses
 import numpy as np
 
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
-from bodyfit.fitter.sections import (mesh_edges, region_edges, section_centre,
+from bodyfit.fitter.sections import (mesh_edges, region_edges, section_axes, section_centre,
                                      section_points, tape_lengths)
 
 __all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "Measurer"]
@@ -92,6 +92,7 @@ SECTION_GIRTHS = ("B", "D", "E", "F")
 _SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs"}
 
 _UP = np.array([0.0, 0.0, 1.0])
+_ACROSS = np.array([1.0, 0.0, 0.0])  # a section's first axis: across, as a front photo shows
 _SIDES = ("L", "R")
 
 
@@ -210,8 +211,13 @@ class Measurer:
         photo does); ``vertices``: (V, 3) metres."""
         v = np.asarray(vertices, np.float64)
         origin, normal = self.girth_plane(v, key)
-        return section_points(v, self._edges[_SECTION_REGIONS[key]], origin, normal,
-                              np.array([1.0, 0, 0]))
+        return section_points(v, self._edges[_SECTION_REGIONS[key]], origin, normal, _ACROSS)
+
+    def girth_axes(self, vertices: np.ndarray, key: str) -> np.ndarray:
+        """(2, 3) float64: the unit axes of :meth:`girth_section`'s frame (across the body,
+        then front to back, in girth ``key``'s plane) in the body's frame; ``vertices``:
+        (V, 3) metres."""
+        return section_axes(self.girth_plane(vertices, key)[1], _ACROSS)
 
     def girth_centre(self, vertices: np.ndarray, key: str) -> np.ndarray:
         """(3,) float64, metres: the mean of girth ``key``'s section points

@@ -7,26 +7,33 @@ wide or narrow on average, its circumference 7.9 mm off (docs/accuracy.md, "Push
 numbers", steps 26 and 28). The photo itself shows that width at its own resolution. So
 for the girths of :data:`PHOTO_EXTENTS`, after the fit, each listed view's photo is
 compared with the fitted body rendered through the same camera at the photo's resolution:
-the ratio of the person's outline width to the body's, averaged over the rows around the
-tape's centre, scales the fitted section along that view's axis (the front view's across
-the body, the side view's front to back), and the tape is the scaled section's convex hull.
+the ratio of the person's outline width to the body's, averaged over the lines along the
+tape around its centre, scales the fitted section along that view's axis (the front
+view's across the body, the side view's front to back), and the tape is the scaled
+section's convex hull.
 
 - The camera is placed from the fitted body in the view's pose (as the search places it:
   :func:`~bodyfit.fitter.pinhole_canvas.solve_placement`), so the body's crown and toes
   fall on the silhouette's top and bottom rows and the tape's rows are the person's.
-- A width is the foreground run of a photo row that holds the projected section's centre
-  (or lies nearest it), in the person's mask and in the body's render alike; only the
-  band of rows around the tape is rendered (a crop of the camera), so photos of any size
-  cost the same.
+- The view is first turned about its camera's optical axis (:func:`turned_to_tape`) so
+  that the tape's line in the photo, its section's axis of that view, runs along a row:
+  the front photo's trunk tapes lie along its rows already, the side photo's neck tape is
+  tilted 8-15 degrees, down towards the throat, and a row through its centre would meet
+  the chin.
+- A width is the foreground run of a (turned) photo row that holds the projected
+  section's centre (or lies nearest it), in the person's mask and in the body's render
+  alike; only the band of rows around the tape is rendered (a crop of the camera), so
+  photos of any size cost the same.
 - The scaling is skipped (the fitted girth kept) where the rendered body's outline at
   those rows is not the girth's own part (an arm against the chest, the jaw over the
-  neck), where the person's outline reaches into another part of the rendered body (the
+  neck in the front photo; in the side photo the jaw's underside, the head's part,
+  reaches the neck tape's front end), where the person's outline reaches into another part of the rendered body (the
   person's arm touches the chest where the body's does not), or where the ratio strays
   beyond :data:`MAX_CHANGE` (hair or clothing, not the body, makes that outline).
-- Which girths and views: chosen by measured error (docs/accuracy.md step 28): the
-  neck's, the chest's, the waist's and the hip's width from the front photo. The side
-  photo's depths lost in-space (the neck's side outline at the tape is the chin's, the
-  hip's holds the hands); the limbs' girths are not scaled.
+- Which girths and views: chosen by measured error (docs/accuracy.md steps 28-29): the
+  neck's, the chest's, the waist's and the hip's width from the front photo, and the
+  neck's depth from the side photo along its tilted tape. The trunk's side depths lost
+  in-space (the hip's holds the hands); the limbs' girths are not scaled.
 
 Pinhole views only (the photos' own camera); the paper's orthographic method measures
 the fitted mesh alone.
@@ -36,6 +43,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import cv2
 import numpy as np
 
 from bodyfit import kernels
@@ -46,15 +54,17 @@ from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["PHOTO_EXTENTS", "MAX_CHANGE", "ViewPhoto", "outline_width", "placed_camera",
-           "extent_ratio", "section_scales", "photo_scaled_girths"]
+           "turned_to_tape", "extent_ratio", "section_scales", "photo_scaled_girths"]
 
 #: girth key -> the views whose photo sets its section's extent ("front": across the
 #: body, the section's first axis; "side": front to back, its second).
-PHOTO_EXTENTS = {"B": ("front",), "D": ("front",), "E": ("front",), "F": ("front",)}
+PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",)}
 #: The largest relative change of an extent the photos may make.
 MAX_CHANGE = 0.2
-#: Each girth's own parts: the rendered outline at the tape's rows must be of these.
-_GIRTH_PARTS = {"B": ("neck",), "D": ("chest",), "E": ("waist",), "F": ("hip", "leg")}
+#: (girth, view) -> its own parts: the rendered outline at the tape's rows must be of these.
+_GIRTH_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
+                ("D", "front"): ("chest",), ("E", "front"): ("waist",),
+                ("F", "front"): ("hip", "leg")}
 _BAND_ROWS = 2  # rows above and below the tape's centre row
 _SUBPIXELS = 4  # the body's render cuts each photo column into as many
 _MARGIN_PX = 8
@@ -118,6 +128,37 @@ def placed_camera(model: BodyModel, photo: ViewPhoto) -> tuple[np.ndarray, np.nd
     return placement.extrinsics(photo.name)
 
 
+def turned_to_tape(measurer: Measurer, key: str, photo: ViewPhoto,
+                   camera: tuple[np.ndarray, np.ndarray]
+                   ) -> tuple[ViewPhoto, tuple[np.ndarray, np.ndarray]]:
+    """The view's photo and camera (R, t) turned about the camera's optical axis so that
+    girth ``key``'s tape line, its section's axis of the view (:meth:`Measurer.girth_axes`)
+    through its centre, runs along a row, the centre's pixel kept where it was: the mask
+    warped by the turn's homography (K Rz K^-1, then a shift; bilinear, over half
+    covered is person), K shifted by the same, R and t turned by Rz. The line's direction
+    is taken within a quarter turn of the rows, so the photo stays upright."""
+    rotation, translation = camera
+    k = np.asarray(photo.intrinsics, float)
+    centre = measurer.girth_centre(photo.body, key)
+    axis = measurer.girth_axes(photo.body, key)[_AXES[photo.name]]
+    ends = np.stack([centre, centre + 0.05 * axis]) @ rotation.T + translation
+    pixels = (ends / ends[:, 2:]) @ k.T
+    du, dv = pixels[1, :2] - pixels[0, :2]
+    angle = (np.arctan2(dv, du) + np.pi / 2) % np.pi - np.pi / 2
+    c, s = np.cos(-angle), np.sin(-angle)
+    turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    homography = k @ turn @ np.linalg.inv(k)
+    moved = homography @ pixels[0]
+    shift = np.eye(3)
+    shift[:2, 2] = pixels[0, :2] - moved[:2] / moved[2]
+    homography = shift @ homography
+    height, width = photo.mask.shape
+    mask = cv2.warpPerspective(photo.mask.astype(np.float32), homography, (width, height),
+                               flags=cv2.INTER_LINEAR) > 0.5
+    turned = dataclasses.replace(photo, mask=mask, intrinsics=shift @ k)
+    return turned, (turn @ rotation, turn @ translation)
+
+
 def _band_render(model: BodyModel, photo: ViewPhoto, rotation, translation, rows: range,
                  columns: range) -> np.ndarray:
     """(len(rows), len(columns) * _SUBPIXELS) int8 part labels (-1: background) of the
@@ -135,9 +176,10 @@ def _band_render(model: BodyModel, photo: ViewPhoto, rotation, translation, rows
 
 def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhoto,
                  camera: tuple[np.ndarray, np.ndarray]) -> float | None:
-    """The person's outline width over the fitted body's at girth ``key``'s tape in the
-    view's photo (module docstring), the photo's camera (R, t) placed by
-    :func:`placed_camera`; None where the rendered outline there is not the girth's own
+    """The person's outline width over the fitted body's along the rows of the view's
+    photo around girth ``key``'s tape centre (module docstring; the photo turned by
+    :func:`turned_to_tape`), the photo's camera (R, t) placed by :func:`placed_camera` (and
+    turned with it); None where the rendered outline there is not the girth's own
     part, where the person's outline reaches into another run of the render, or where
     the ratio strays beyond :data:`MAX_CHANGE`."""
     rotation, translation = camera
@@ -154,7 +196,7 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhot
         return None
     columns = range(max(0, mask_cols[0] - _MARGIN_PX), min(width, mask_cols[-1] + _MARGIN_PX + 1))
     labels = _band_render(model, photo, rotation, translation, rows, columns)
-    own = [PART_NAMES.index(p) for p in _GIRTH_PARTS[key]]
+    own = [PART_NAMES.index(p) for p in _GIRTH_PARTS[key, photo.name]]
     person, fitted = [], []
     s = _SUBPIXELS
     for i, r in enumerate(rows):
@@ -175,14 +217,15 @@ def section_scales(model: BodyModel, measurer: Measurer,
                    photos: dict[str, ViewPhoto]) -> dict[str, np.ndarray]:
     """key -> (2,) the factors of the girths of :data:`PHOTO_EXTENTS` on their sections'
     extents (across the body, front to back): each the :func:`extent_ratio` of its
-    view's photo in ``photos``, 1 where none applies; each view's camera placed once."""
-    cameras = {name: placed_camera(model, photos[name])
-               for name in {view for views in PHOTO_EXTENTS.values() for view in views}}
+    view's photo in ``photos`` (views missing there: none), turned to the tape
+    (:func:`turned_to_tape`), 1 where none applies; each view's camera placed once."""
+    cameras = {name: placed_camera(model, photo) for name, photo in photos.items()}
     scales = {}
     for key, views in PHOTO_EXTENTS.items():
         scales[key] = np.ones(2)
-        for name in views:
-            ratio = extent_ratio(model, measurer, key, photos[name], cameras[name])
+        for name in set(views) & set(photos):
+            ratio = extent_ratio(model, measurer, key,
+                                 *turned_to_tape(measurer, key, photos[name], cameras[name]))
             if ratio is not None:
                 scales[key][_AXES[name]] = ratio
     return scales

@@ -15,7 +15,7 @@ import cv2
 import numpy as np
 
 __all__ = ["mesh_edges", "region_edges", "plane_basis", "hull_perimeter", "tape_lengths",
-           "section_points", "section_centre"]
+           "section_axes", "section_points", "section_centre"]
 
 
 def mesh_edges(faces: np.ndarray) -> np.ndarray:
@@ -113,11 +113,18 @@ def section_points(vertices: np.ndarray, edges: np.ndarray, origin: np.ndarray,
     """
     n = np.asarray(normal, np.float64)
     n = n / np.linalg.norm(n)
+    points = _sections(vertices, edges, np.atleast_2d(np.asarray(origin, np.float64)), n)[0]
+    return points @ plane_basis(n) @ section_axes(n, across).T
+
+
+def section_axes(normal: np.ndarray, across: np.ndarray) -> np.ndarray:
+    """(2, 3) float64 unit axes of :func:`section_points`' frame, in the mesh's frame:
+    ``across`` (3,) projected onto the plane of ``normal`` (3,), then ``normal`` x it."""
+    n = np.asarray(normal, np.float64)
+    n = n / np.linalg.norm(n)
     first = np.asarray(across, np.float64) - np.dot(across, n) * n
     first /= np.linalg.norm(first)
-    frame = np.stack([first, np.cross(n, first)])
-    points = _sections(vertices, edges, np.atleast_2d(np.asarray(origin, np.float64)), n)[0]
-    return points @ plane_basis(n) @ frame.T
+    return np.stack([first, np.cross(n, first)])
 
 
 def section_centre(vertices: np.ndarray, edges: np.ndarray, origin: np.ndarray,
