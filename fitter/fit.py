@@ -18,7 +18,7 @@ from bodyfit.calib.errors import UserError
 from bodyfit.fitter.body_model import POSE_NAMES, BodyModel, forward, rest_shape
 from bodyfit.fitter.canvas import PAPER_CANVAS, CanvasSettings, extreme_bodies, orthographic_view
 from bodyfit.fitter.measurements import Measurer
-from bodyfit.fitter.photo_extents import ViewPhoto, photo_scaled_girths
+from bodyfit.fitter.photo_extents import ViewPhoto, photo_scaled_measurements
 from bodyfit.fitter.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.render_mesh import render_model
 from bodyfit.fitter.search import (SearchResult, SearchSettings, averaged, refined, search,
@@ -59,9 +59,9 @@ class FitSettings:
             from its best body so far (evenly spaced through the generations;
             :func:`~bodyfit.fitter.pinhole_canvas.placed_anew`); 0: only from the mean
             body, before the search.
-        photo_extents: pinhole only: the girths of
-            :data:`~bodyfit.fitter.photo_extents.PHOTO_EXTENTS` take their section's
-            extents from the photos (:mod:`bodyfit.fitter.photo_extents`); False: every
+        photo_extents: pinhole only: the girths and the shoulder breadth of
+            :data:`~bodyfit.fitter.photo_extents.PHOTO_EXTENTS` take their extents from
+            the photos (:mod:`bodyfit.fitter.photo_extents`); False: every
             measurement is the fitted mesh's.
     """
 
@@ -363,13 +363,13 @@ def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSetti
                         rest: np.ndarray, view_bodies: dict[str, np.ndarray],
                         views: dict[str, kernels.ViewTarget], masks: dict[str, np.ndarray],
                         intrinsics: dict[str, np.ndarray] | None) -> dict[str, float]:
-    """key -> mm: the 16 measurements of the fitted ``rest`` body, the girths of
+    """key -> mm: the 16 measurements of the fitted ``rest`` body, those of
     ``PHOTO_EXTENTS`` scaled to the photos (:func:`view_photos`); the other arguments as
     :func:`fit_person`'s and :func:`fitted_bodies`' answers."""
     measurements = measurer.measure(rest)
     photos = view_photos(settings, views, view_bodies, masks, intrinsics)
     if photos is not None:
-        measurements |= photo_scaled_girths(model, measurer, rest, photos)
+        measurements |= photo_scaled_measurements(model, measurer, rest, photos)
     return measurements
 
 

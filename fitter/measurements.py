@@ -219,6 +219,11 @@ class Measurer:
         (V, 3) metres."""
         return section_axes(self.girth_plane(vertices, key)[1], _ACROSS)
 
+    def acromions(self, vertices: np.ndarray) -> np.ndarray:
+        """(2, 3) float64, metres: the left and right acromion landmarks of ``vertices``
+        (V, 3) metres (the shoulder breadth is their distance)."""
+        return self._point(np.asarray(vertices, np.float64), "acromion")
+
     def girth_centre(self, vertices: np.ndarray, key: str) -> np.ndarray:
         """(3,) float64, metres: the mean of girth ``key``'s section points
         (:meth:`girth_section`) in the body's frame; ``vertices``: (V, 3) metres."""
@@ -239,7 +244,7 @@ class Measurer:
         floor, top = v[:, 2].min(), v[:, 2].max()
         stature = top - floor
         crotch = self._point(v, "crotch")[0]
-        acromion = self._point(v, "acromion")
+        acromion = self.acromions(v)
         out = {}
 
         neck_top = self._ring(v, "neck_top")

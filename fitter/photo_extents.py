@@ -1,4 +1,4 @@
-"""Girths scaled to the extents the photos show at the tape's height.
+"""Girths and the shoulder breadth scaled to the extents the photos show.
 
 The silhouette fit places each outline of the body to about a canvas pixel (at 600 px a
 pixel is the stature over 600, some 3 mm), and where the model cannot follow the person
@@ -10,7 +10,9 @@ compared with the fitted body rendered through the same camera at the photo's re
 the ratio of the person's outline width to the body's, averaged over the lines along the
 tape around its centre, scales the fitted section along that view's axis (the front
 view's across the body, the side view's front to back), and the tape is the scaled
-section's convex hull.
+section's convex hull. The shoulder breadth (the acromions' distance) is scaled the same
+way, by the front photo's outline width across the deltoids :data:`SHOULDER_DROP_M` below
+the acromions.
 
 - The camera is placed from the fitted body in the view's pose (as the search places it:
   :func:`~bodyfit.fitter.pinhole_canvas.solve_placement`), so the body's crown and toes
@@ -30,10 +32,13 @@ section's convex hull.
   reaches the neck tape's front end), where the person's outline reaches into another part of the rendered body (the
   person's arm touches the chest where the body's does not), or where the ratio strays
   beyond :data:`MAX_CHANGE` (hair or clothing, not the body, makes that outline).
-- Which girths and views: chosen by measured error (docs/accuracy.md steps 28-29): the
-  neck's, the chest's, the waist's and the hip's width from the front photo, and the
-  neck's depth from the side photo along its tilted tape. The trunk's side depths lost
-  in-space (the hip's holds the hands); the limbs' girths are not scaled.
+- Which measurements and views: chosen by measured error (docs/accuracy.md steps
+  28-29): the neck's, the chest's, the waist's and the hip's width from the front photo,
+  the neck's depth from the side photo along its tilted tape, the shoulder breadth from
+  the front photo 2 cm below the acromions (at them the outline is the shoulders'
+  rounded top; 2 cm came out better than 0, 1 or 4 cm below on the same fits). The
+  trunk's side depths lost in-space (the hip's holds the hands); the limbs' girths are
+  not scaled.
 
 Pinhole views only (the photos' own camera); the paper's orthographic method measures
 the fitted mesh alone.
@@ -53,22 +58,28 @@ from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["PHOTO_EXTENTS", "MAX_CHANGE", "ViewPhoto", "outline_width", "placed_camera",
-           "turned_to_tape", "extent_ratio", "section_scales", "photo_scaled_girths"]
+__all__ = ["PHOTO_EXTENTS", "MAX_CHANGE", "SHOULDER_DROP_M", "ViewPhoto", "outline_width",
+           "placed_camera", "turned_to_tape", "extent_ratio", "section_scales",
+           "photo_scaled_measurements"]
 
-#: girth key -> the views whose photo sets its section's extent ("front": across the
-#: body, the section's first axis; "side": front to back, its second).
-PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",)}
+#: measurement key -> the views whose photo sets its extent ("front": across the body, a
+#: girth section's first axis; "side": front to back, its second): the girths of
+#: ``Measurer.SECTION_GIRTHS`` and the shoulder breadth "P".
+PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
+                 "P": ("front",)}
 #: The largest relative change of an extent the photos may make.
 MAX_CHANGE = 0.2
-#: (girth, view) -> its own parts: the rendered outline at the tape's rows must be of these.
+#: The shoulder breadth's line lies this far (metres) below the acromions' midpoint.
+SHOULDER_DROP_M = 0.02
+#: (key, view) -> its own parts: the rendered outline at the tape's rows must be of these.
 _GIRTH_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
                 ("D", "front"): ("chest",), ("E", "front"): ("waist",),
-                ("F", "front"): ("hip", "leg")}
+                ("F", "front"): ("hip", "leg"), ("P", "front"): ("arm",)}
 _BAND_ROWS = 2  # rows above and below the tape's centre row
 _SUBPIXELS = 4  # the body's render cuts each photo column into as many
 _MARGIN_PX = 8
 _AXES = {"front": 0, "side": 1}
+_ACROSS = np.array([1.0, 0.0, 0.0])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -128,19 +139,29 @@ def placed_camera(model: BodyModel, photo: ViewPhoto) -> tuple[np.ndarray, np.nd
     return placement.extrinsics(photo.name)
 
 
+def _tape_line(measurer: Measurer, body: np.ndarray, key: str,
+               view: str) -> tuple[np.ndarray, np.ndarray]:
+    """((3,) centre, (3,) unit direction), metres, body frame: where measurement ``key``'s
+    extent is read on ``body`` (V, 3) in the ``view``'s photo: a girth's section centre and
+    its axis of the view (:meth:`Measurer.girth_axes`); the shoulder breadth's point
+    :data:`SHOULDER_DROP_M` below the acromions' midpoint, across the body."""
+    if key == "P":
+        return measurer.acromions(body).mean(axis=0) - [0.0, 0.0, SHOULDER_DROP_M], _ACROSS
+    return measurer.girth_centre(body, key), measurer.girth_axes(body, key)[_AXES[view]]
+
+
 def turned_to_tape(measurer: Measurer, key: str, photo: ViewPhoto,
                    camera: tuple[np.ndarray, np.ndarray]
                    ) -> tuple[ViewPhoto, tuple[np.ndarray, np.ndarray]]:
     """The view's photo and camera (R, t) turned about the camera's optical axis so that
-    girth ``key``'s tape line, its section's axis of the view (:meth:`Measurer.girth_axes`)
-    through its centre, runs along a row, the centre's pixel kept where it was: the mask
+    measurement ``key``'s line (:func:`_tape_line`: for a girth its section's axis of the
+    view through its centre) runs along a row, the centre's pixel kept where it was: the mask
     warped by the turn's homography (K Rz K^-1, then a shift; bilinear, over half
     covered is person), K shifted by the same, R and t turned by Rz. The line's direction
     is taken within a quarter turn of the rows, so the photo stays upright."""
     rotation, translation = camera
     k = np.asarray(photo.intrinsics, float)
-    centre = measurer.girth_centre(photo.body, key)
-    axis = measurer.girth_axes(photo.body, key)[_AXES[photo.name]]
+    centre, axis = _tape_line(measurer, photo.body, key, photo.name)
     ends = np.stack([centre, centre + 0.05 * axis]) @ rotation.T + translation
     pixels = (ends / ends[:, 2:]) @ k.T
     du, dv = pixels[1, :2] - pixels[0, :2]
@@ -177,14 +198,14 @@ def _band_render(model: BodyModel, photo: ViewPhoto, rotation, translation, rows
 def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhoto,
                  camera: tuple[np.ndarray, np.ndarray]) -> float | None:
     """The person's outline width over the fitted body's along the rows of the view's
-    photo around girth ``key``'s tape centre (module docstring; the photo turned by
+    photo around measurement ``key``'s line (module docstring; the photo turned by
     :func:`turned_to_tape`), the photo's camera (R, t) placed by :func:`placed_camera` (and
-    turned with it); None where the rendered outline there is not the girth's own
+    turned with it); None where the rendered outline there is not the measurement's own
     part, where the person's outline reaches into another run of the render, or where
     the ratio strays beyond :data:`MAX_CHANGE`."""
     rotation, translation = camera
     k = np.asarray(photo.intrinsics, float)
-    cam = rotation @ measurer.girth_centre(photo.body, key) + translation
+    cam = rotation @ _tape_line(measurer, photo.body, key, photo.name)[0] + translation
     u, v = (k[:2, :2] @ (cam[:2] / cam[2])) + k[:2, 2]
     height, width = photo.mask.shape
     row = int(round(v))
@@ -215,8 +236,9 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhot
 
 def section_scales(model: BodyModel, measurer: Measurer,
                    photos: dict[str, ViewPhoto]) -> dict[str, np.ndarray]:
-    """key -> (2,) the factors of the girths of :data:`PHOTO_EXTENTS` on their sections'
-    extents (across the body, front to back): each the :func:`extent_ratio` of its
+    """key -> (2,) the factors of the measurements of :data:`PHOTO_EXTENTS` on their
+    extents (across the body, front to back; the shoulder breadth's second unused): each
+    the :func:`extent_ratio` of its
     view's photo in ``photos`` (views missing there: none), turned to the tape
     (:func:`turned_to_tape`), 1 where none applies; each view's camera placed once."""
     cameras = {name: placed_camera(model, photo) for name, photo in photos.items()}
@@ -231,10 +253,17 @@ def section_scales(model: BodyModel, measurer: Measurer,
     return scales
 
 
-def photo_scaled_girths(model: BodyModel, measurer: Measurer, rest: np.ndarray,
-                        photos: dict[str, ViewPhoto]) -> dict[str, float]:
-    """key -> mm: the girths of :data:`PHOTO_EXTENTS` of the fitted body ``rest`` (V, 3)
-    metres (rest A-pose, at the person's stature), each its section scaled by its
-    :func:`section_scales` (a girth no ratio applies to keeps its fitted value)."""
-    return {key: 1000.0 * hull_perimeter(measurer.girth_section(rest, key) * scale)
-            for key, scale in section_scales(model, measurer, photos).items()}
+def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.ndarray,
+                              photos: dict[str, ViewPhoto]) -> dict[str, float]:
+    """key -> mm: the measurements of :data:`PHOTO_EXTENTS` of the fitted body ``rest``
+    (V, 3) metres (rest A-pose, at the person's stature), scaled by their
+    :func:`section_scales`: a girth its section, the shoulder breadth its length (one no
+    ratio applies to keeps its fitted value)."""
+    scaled = {}
+    for key, scale in section_scales(model, measurer, photos).items():
+        if key == "P":
+            left, right = measurer.acromions(rest)
+            scaled[key] = 1000.0 * float(np.linalg.norm(left - right)) * scale[0]
+        else:
+            scaled[key] = 1000.0 * hull_perimeter(measurer.girth_section(rest, key) * scale)
+    return scaled

@@ -1,5 +1,6 @@
-"""Girths scaled to the photos' extents: a person whose neck is wider (or deeper) than the
-fitted body's, photographed through a known camera, gives back that neck's girth."""
+"""Girths and the shoulder breadth scaled to the photos' extents: a person whose neck is
+wider (or deeper), or whose shoulders are broader, than the fitted body's, photographed
+through a known camera, gives back that neck's girth or those shoulders' breadth."""
 
 import cv2
 import numpy as np
@@ -8,7 +9,7 @@ import pytest
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
 from bodyfit.fitter.photo_extents import (MAX_CHANGE, ViewPhoto, extent_ratio,
-                                          outline_width, photo_scaled_girths, placed_camera,
+                                          outline_width, photo_scaled_measurements, placed_camera,
                                           turned_to_tape)
 from bodyfit.fitter.pinhole_canvas import Placement
 
@@ -79,7 +80,7 @@ def test_the_neck_girth_follows_the_photo(body_model, measurer, mean_body, facto
     posed, rest = mean_body
     person = _photo_of(body_model, _neck_widened(body_model, measurer, posed, factor))
     photo = ViewPhoto("front", person, K, posed, PART_NAMES)
-    got = photo_scaled_girths(body_model, measurer, rest, {"front": photo})["B"]
+    got = photo_scaled_measurements(body_model, measurer, rest, {"front": photo})["B"]
     fitted = measurer.measure(rest)["B"]
     true = measurer.measure(_neck_widened(body_model, measurer, rest, factor))["B"]
     if factor == 1.0:
@@ -96,13 +97,43 @@ def test_the_neck_girth_follows_the_side_photo(body_model, measurer, mean_body, 
     posed, rest = mean_body
     person = _photo_of(body_model, _neck_deepened(measurer, posed, factor), "side")
     photo = ViewPhoto("side", person, K, posed, PART_NAMES)
-    got = photo_scaled_girths(body_model, measurer, rest, {"side": photo})["B"]
+    got = photo_scaled_measurements(body_model, measurer, rest, {"side": photo})["B"]
     fitted = measurer.measure(rest)["B"]
     true = measurer.measure(_neck_deepened(measurer, rest, factor))["B"]
     if factor == 1.0:
         assert got == pytest.approx(fitted, rel=0.005)
     else:
         assert abs(got - true) < abs(true - fitted) / 3
+
+
+def _shoulders_widened(measurer, vertices: np.ndarray, factor: float) -> np.ndarray:
+    """``vertices`` (V, 3) with the body's x scaled by ``factor`` about its middle from 5
+    cm below the acromions up (the shoulders, neck and head), not at all from 15 cm below,
+    evenly between."""
+    out = vertices.astype(np.float64).copy()
+    top = measurer.acromions(out)[:, 2].mean()
+    weight = np.clip((out[:, 2] - (top - 0.15)) / 0.1, 0, 1)
+    middle = measurer.acromions(out)[:, 0].mean()
+    out[:, 0] = middle + (1 + (factor - 1) * weight) * (out[:, 0] - middle)
+    return out
+
+
+@pytest.mark.parametrize("factor", [1.0, 1.05, 0.96])
+def test_the_shoulder_breadth_follows_the_photo(body_model, measurer, mean_body, factor):
+    """As for the neck, the shoulders ``factor`` times as broad: the shoulder breadth
+    moves at least 80 % of the way to the person's (the arms' outline 2 cm below the
+    acromions, about 200 px across)."""
+    posed, rest = mean_body
+    person = _photo_of(body_model, _shoulders_widened(measurer, posed, factor))
+    photo = ViewPhoto("front", person, K, posed, PART_NAMES)
+    got = photo_scaled_measurements(body_model, measurer, rest, {"front": photo})["P"]
+    fitted = measurer.measure(rest)["P"]
+    true = measurer.measure(_shoulders_widened(measurer, rest, factor))["P"]
+    assert true == pytest.approx(fitted * factor)
+    if factor == 1.0:
+        assert got == pytest.approx(fitted, rel=0.005)
+    else:
+        assert abs(got - true) < 0.2 * abs(true - fitted)
 
 
 def test_the_turned_view_is_the_photo_of_a_turned_camera(body_model, measurer, mean_body):
@@ -132,7 +163,7 @@ def test_a_change_beyond_the_bound_keeps_the_fitted_girth(body_model, measurer, 
     wide = 1.0 + 2 * MAX_CHANGE
     person = _photo_of(body_model, _neck_widened(body_model, measurer, posed, wide))
     photo = ViewPhoto("front", person, K, posed, PART_NAMES)
-    got = photo_scaled_girths(body_model, measurer, rest, {"front": photo})["B"]
+    got = photo_scaled_measurements(body_model, measurer, rest, {"front": photo})["B"]
     assert got == pytest.approx(measurer.measure(rest)["B"], abs=1e-6)
 
 
