@@ -36,7 +36,7 @@ the acromions.
   28-29): the neck's, the chest's, the waist's and the hip's width from the front photo,
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
-  rounded top; 2 cm came out better than 0, 1 or 4 cm below on the same fits). The
+  rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits). The
   trunk's side depths lost in-space (the hip's holds the hands); the limbs' girths are
   not scaled.
 
