@@ -26,19 +26,20 @@ the acromions.
   section's centre (or lies nearest it), in the person's mask and in the body's render
   alike; only the band of rows around the tape is rendered (a crop of the camera), so
   photos of any size cost the same.
-- The scaling is skipped (the fitted girth kept) where the rendered body's outline at
-  those rows is not the girth's own part (an arm against the chest, the jaw over the
-  neck in the front photo; in the side photo the jaw's underside, the head's part,
-  reaches the neck tape's front end), where the person's outline reaches into another part of the rendered body (the
-  person's arm touches the chest where the body's does not), or where the ratio strays
-  beyond :data:`MAX_CHANGE` (hair or clothing, not the body, makes that outline).
+- The scaling is skipped (the fitted value kept) where the rendered body's outline at
+  those rows is not the measurement's own part (an arm against the chest, the jaw over
+  the neck in the front photo; in the side photo the jaw's underside, the head's part,
+  is the neck tape's front end and counts as the neck's), where the person's outline
+  reaches into another part of the rendered body (the person's arm touches the chest
+  where the body's does not), or where the ratio strays beyond :data:`MAX_CHANGE` (hair
+  or clothing, not the body, makes that outline).
 - Which measurements and views: chosen by measured error (docs/accuracy.md steps
   28-29): the neck's, the chest's, the waist's and the hip's width from the front photo,
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
-  rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits). The
-  trunk's side depths lost in-space (the hip's holds the hands); the limbs' girths are
-  not scaled.
+  rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits).
+  The trunk's side depths lost in-space (the hip's holds the hands); the limbs' girths
+  are not scaled.
 
 Pinhole views only (the photos' own camera); the paper's orthographic method measures
 the fitted mesh alone.
@@ -72,7 +73,7 @@ MAX_CHANGE = 0.2
 #: The shoulder breadth's line lies this far (metres) below the acromions' midpoint.
 SHOULDER_DROP_M = 0.02
 #: (key, view) -> its own parts: the rendered outline at the tape's rows must be of these.
-_GIRTH_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
+_OWN_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
                 ("D", "front"): ("chest",), ("E", "front"): ("waist",),
                 ("F", "front"): ("hip", "leg"), ("P", "front"): ("arm",)}
 _BAND_ROWS = 2  # rows above and below the tape's centre row
@@ -155,8 +156,8 @@ def turned_to_tape(measurer: Measurer, key: str, photo: ViewPhoto,
                    ) -> tuple[ViewPhoto, tuple[np.ndarray, np.ndarray]]:
     """The view's photo and camera (R, t) turned about the camera's optical axis so that
     measurement ``key``'s line (:func:`_tape_line`: for a girth its section's axis of the
-    view through its centre) runs along a row, the centre's pixel kept where it was: the mask
-    warped by the turn's homography (K Rz K^-1, then a shift; bilinear, over half
+    view through its centre) runs along a row, the centre's pixel kept where it was: the
+    mask warped by the turn's homography (K Rz K^-1, then a shift; bilinear, over half
     covered is person), K shifted by the same, R and t turned by Rz. The line's direction
     is taken within a quarter turn of the rows, so the photo stays upright."""
     rotation, translation = camera
@@ -217,7 +218,7 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhot
         return None
     columns = range(max(0, mask_cols[0] - _MARGIN_PX), min(width, mask_cols[-1] + _MARGIN_PX + 1))
     labels = _band_render(model, photo, rotation, translation, rows, columns)
-    own = [PART_NAMES.index(p) for p in _GIRTH_PARTS[key, photo.name]]
+    own = [PART_NAMES.index(p) for p in _OWN_PARTS[key, photo.name]]
     person, fitted = [], []
     s = _SUBPIXELS
     for i, r in enumerate(rows):
@@ -238,9 +239,9 @@ def section_scales(model: BodyModel, measurer: Measurer,
                    photos: dict[str, ViewPhoto]) -> dict[str, np.ndarray]:
     """key -> (2,) the factors of the measurements of :data:`PHOTO_EXTENTS` on their
     extents (across the body, front to back; the shoulder breadth's second unused): each
-    the :func:`extent_ratio` of its
-    view's photo in ``photos`` (views missing there: none), turned to the tape
-    (:func:`turned_to_tape`), 1 where none applies; each view's camera placed once."""
+    the :func:`extent_ratio` of its view's photo in ``photos`` (views missing there:
+    none), turned to the tape (:func:`turned_to_tape`), 1 where none applies; each view's
+    camera placed once."""
     cameras = {name: placed_camera(model, photo) for name, photo in photos.items()}
     scales = {}
     for key, views in PHOTO_EXTENTS.items():
