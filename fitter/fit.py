@@ -60,8 +60,8 @@ class FitSettings:
             :func:`~bodyfit.fitter.pinhole_canvas.placed_anew`); 0: only from the mean
             body, before the search.
         photo_extents: pinhole only: the girths and the shoulder breadth of
-            :data:`~bodyfit.fitter.photo_extents.PHOTO_EXTENTS` take their extents from
-            the photos (:mod:`bodyfit.fitter.photo_extents`); False: every
+            :data:`~bodyfit.fitter.photo_extents.SCALED` take their extents from the
+            photos (:mod:`bodyfit.fitter.photo_extents`); False: every
             measurement is the fitted mesh's.
     """
 
@@ -364,7 +364,7 @@ def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSetti
                         views: dict[str, kernels.ViewTarget], masks: dict[str, np.ndarray],
                         intrinsics: dict[str, np.ndarray] | None) -> dict[str, float]:
     """key -> mm: the 16 measurements of the fitted ``rest`` body, those of
-    ``PHOTO_EXTENTS`` scaled to the photos (:func:`view_photos`); the other arguments as
+    ``photo_extents.SCALED`` scaled to the photos (:func:`view_photos`); the other arguments as
     :func:`fit_person`'s and :func:`fitted_bodies`' answers."""
     measurements = measurer.measure(rest)
     photos = view_photos(settings, views, view_bodies, masks, intrinsics)

@@ -62,7 +62,7 @@ from bodyfit.fitter.body_model import PART_NAMES, BodyModel
 from bodyfit.fitter.sections import (mesh_edges, region_edges, section_axes, section_centre,
                                      section_points, tape_lengths)
 
-__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "Measurer"]
+__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "BICEP_SECTIONS", "Measurer"]
 
 #: key -> (snake_case name, human name), in the paper's Fig. 10 order.
 MEASUREMENTS = {
@@ -89,7 +89,11 @@ IMPORTANT = ("B", "C", "D", "E", "F", "L", "P")
 #: The girths taken on one plane section (the others: the largest of several planes, or
 #: a limb's two sides), and the region each tape keeps to.
 SECTION_GIRTHS = ("B", "D", "E", "F")
-_SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs"}
+#: The bicep girth's two tapes, left and right (the bicep circumference is their mean):
+#: plane sections too (:meth:`Measurer.girth_plane` and the rest take these keys).
+BICEP_SECTIONS = ("H.L", "H.R")
+_SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs",
+                    "H.L": "upperarm.L", "H.R": "upperarm.R"}
 
 _UP = np.array([0.0, 0.0, 1.0])
 _ACROSS = np.array([1.0, 0.0, 0.0])  # a section's first axis: across, as a front photo shows
@@ -185,11 +189,21 @@ class Measurer:
         return tape_lengths(vertices, self._edges[region], origins, _UP)
 
     def girth_plane(self, vertices: np.ndarray, key: str) -> tuple[np.ndarray, np.ndarray]:
-        """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS``) and (3,) its
-        normal, on ``vertices`` (V, 3) metres, rest A-pose (or posed: the trunk and neck do
-        not move with the pose's four angles). The neck's: midway between the neck's base
-        and top rings, perpendicular to the line joining them; the trunk's: horizontal."""
+        """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS`` or
+        ``BICEP_SECTIONS``) and (3,) its normal, on ``vertices`` (V, 3) metres, rest A-pose
+        or posed (the trunk and neck do not move with the pose's four angles, a bicep's
+        plane follows its arm). The neck's: midway between the neck's base and top rings,
+        perpendicular to the line joining them; the trunk's: horizontal; a bicep's:
+        perpendicular to the upper arm's axis (its shoulder ring's centre to its elbow
+        ring's), where the point midway between acromion and elbow projects onto it."""
         v = np.asarray(vertices, np.float64)
+        if key in BICEP_SECTIONS:
+            side, spec = BICEP_SECTIONS.index(key), _LIMBS["upperarm"]
+            top = self._ring(v, spec.upper_ring, _SIDES[side])
+            bottom = self._ring(v, spec.lower_ring, _SIDES[side])
+            axis = bottom - top
+            midway = 0.5 * (self.acromions(v)[side] + bottom)
+            return top + np.dot(midway - top, axis) / np.sum(axis ** 2) * axis, axis
         if key == "B":
             base, top = self._ring(v, "neck_base"), self._ring(v, "neck_top")
             return 0.5 * (base + top), top - base
@@ -201,7 +215,7 @@ class Measurer:
             buttocks = v[self._buttock_vertices]
             height = buttocks[np.argmax(buttocks[:, 1]), 2]
         else:
-            raise KeyError(f"{key!r} is not one of {SECTION_GIRTHS}")
+            raise KeyError(f"{key!r} is not one of {SECTION_GIRTHS + BICEP_SECTIONS}")
         return np.array([0.0, 0.0, height]), _UP
 
     def girth_section(self, vertices: np.ndarray, key: str) -> np.ndarray:
@@ -256,11 +270,9 @@ class Measurer:
                                     *self.girth_plane(v, key))[0]
         out["C"] = acromion[:, 2].mean() - crotch[2]
         out["G"] = self._limb_girths(v, "wrist", np.array([1.0]), np.nanmax)
-        # midway between acromion and elbow: where that point projects onto the axis
-        out["H"] = self._limb_girths(
-            v, "upperarm", lambda top, bottom, i: np.dot(0.5 * (acromion[i] + bottom) - top,
-                                                         bottom - top) / np.sum((bottom - top) ** 2),
-            np.nanmax)
+        out["H"] = np.mean([tape_lengths(v, self._edges[_SECTION_REGIONS[key]],
+                                         *self.girth_plane(v, key))[0]
+                            for key in BICEP_SECTIONS])
         out["I"] = self._limb_girths(v, "forearm", np.linspace(0.1, 0.4, 7), np.nanmax)
         radiale, stylion = self._point(v, "radiale"), self._point(v, "stylion")
         out["J"] = float(np.mean(np.linalg.norm(acromion - radiale, axis=1)

@@ -10,9 +10,10 @@ compared with the fitted body rendered through the same camera at the photo's re
 the ratio of the person's outline width to the body's, averaged over the lines along the
 tape around its centre, scales the fitted section along that view's axis (the front
 view's across the body, the side view's front to back), and the tape is the scaled
-section's convex hull. The shoulder breadth (the acromions' distance) is scaled the same
-way, by the front photo's outline width across the deltoids :data:`SHOULDER_DROP_M` below
-the acromions.
+section's convex hull. The bicep's two tapes are scaled each by its arm's width across
+its tape in the front photo, the bicep circumference their mean. The shoulder breadth
+(the acromions' distance) is scaled the same way, by the front photo's outline width
+across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
 
 - The camera is placed from the fitted body in the view's pose (as the search places it:
   :func:`~bodyfit.fitter.pinhole_canvas.solve_placement`), so the body's crown and toes
@@ -37,9 +38,10 @@ the acromions.
   28-29): the neck's, the chest's, the waist's and the hip's width from the front photo,
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
-  rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits).
-  The trunk's side depths lost in-space (the hip's holds the hands); the limbs' girths
-  are not scaled.
+  rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits),
+  the bicep's width from the front photo (its tape tilted with the A-pose's arm). The
+  trunk's side depths lost in-space (the hip's holds the hands); the side photo's arms
+  hang against the body; the other limbs' girths are not scaled.
 
 Pinhole views only (the photos' own camera); the paper's orthographic method measures
 the fitted mesh alone.
@@ -54,20 +56,24 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
-from bodyfit.fitter.measurements import Measurer
+from bodyfit.fitter.measurements import BICEP_SECTIONS, Measurer
 from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["PHOTO_EXTENTS", "MAX_CHANGE", "SHOULDER_DROP_M", "ViewPhoto", "outline_width",
+__all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "ViewPhoto",
+           "outline_width",
            "placed_camera", "turned_to_tape", "extent_ratio", "section_scales",
            "photo_scaled_measurements"]
 
-#: measurement key -> the views whose photo sets its extent ("front": across the body, a
-#: girth section's first axis; "side": front to back, its second): the girths of
-#: ``Measurer.SECTION_GIRTHS`` and the shoulder breadth "P".
+#: tape key -> the views whose photo sets its extent ("front": across the body, a girth
+#: section's first axis; "side": front to back, its second): the girths of
+#: ``SECTION_GIRTHS``, the bicep's two tapes (``BICEP_SECTIONS``) and the shoulder
+#: breadth "P".
 PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
-                 "P": ("front",)}
+                 "H.L": ("front",), "H.R": ("front",), "P": ("front",)}
+#: The measurements (MEASUREMENTS keys) the photos scale.
+SCALED = ("B", "D", "E", "F", "H", "P")
 #: The largest relative change of an extent the photos may make.
 MAX_CHANGE = 0.2
 #: The shoulder breadth's line lies this far (metres) below the acromions' midpoint.
@@ -75,7 +81,8 @@ SHOULDER_DROP_M = 0.02
 #: (key, view) -> its own parts: the rendered outline at the tape's rows must be of these.
 _OWN_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
                 ("D", "front"): ("chest",), ("E", "front"): ("waist",),
-                ("F", "front"): ("hip", "leg"), ("P", "front"): ("arm",)}
+                ("F", "front"): ("hip", "leg"), ("H.L", "front"): ("arm",),
+                ("H.R", "front"): ("arm",), ("P", "front"): ("arm",)}
 _BAND_ROWS = 2  # rows above and below the tape's centre row
 _SUBPIXELS = 4  # the body's render cuts each photo column into as many
 _MARGIN_PX = 8
@@ -256,10 +263,11 @@ def section_scales(model: BodyModel, measurer: Measurer,
 
 def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.ndarray,
                               photos: dict[str, ViewPhoto]) -> dict[str, float]:
-    """key -> mm: the measurements of :data:`PHOTO_EXTENTS` of the fitted body ``rest``
-    (V, 3) metres (rest A-pose, at the person's stature), scaled by their
-    :func:`section_scales`: a girth its section, the shoulder breadth its length (one no
-    ratio applies to keeps its fitted value)."""
+    """key -> mm: the measurements :data:`SCALED` of the fitted body ``rest`` (V, 3)
+    metres (rest A-pose, at the person's stature), their tapes of :data:`PHOTO_EXTENTS`
+    scaled by their :func:`section_scales`: a girth its section (the bicep: the mean of
+    its two), the shoulder breadth its length (a tape no ratio applies to keeps its
+    fitted value)."""
     scaled = {}
     for key, scale in section_scales(model, measurer, photos).items():
         if key == "P":
@@ -267,4 +275,5 @@ def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.nda
             scaled[key] = 1000.0 * float(np.linalg.norm(left - right)) * scale[0]
         else:
             scaled[key] = 1000.0 * hull_perimeter(measurer.girth_section(rest, key) * scale)
+    scaled["H"] = float(np.mean([scaled.pop(key) for key in BICEP_SECTIONS]))
     return scaled

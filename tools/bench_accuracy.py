@@ -93,7 +93,7 @@ from bodyfit.fitter.fit import METHODS, stature_conditioner
 from bodyfit.fitter.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_cache import load_model
 from bodyfit.fitter.outputs import write_fitted_measurements, write_text
-from bodyfit.fitter.photo_extents import PHOTO_EXTENTS, section_scales
+from bodyfit.fitter.photo_extents import SCALED, section_scales
 from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import read_run_config, run_config
 from bodyfit.fitter.sections import hull_perimeter
@@ -450,9 +450,9 @@ def remeasure(args) -> None:
         rows.append(summary_row(out / subject, previous[subject]["status"],
                                 float(seconds) if seconds else None))
         others = max(abs(values[key] - _old(written, key)) for key in MEASUREMENTS
-                     if key not in PHOTO_EXTENTS)
+                     if key not in SCALED)
         print(f"{subject}: " + ", ".join(f"{key} {values[key] - _old(written, key):+.1f} mm"
-                                         for key in PHOTO_EXTENTS)
+                                         for key in SCALED)
               + f"; the others as written to within {others:.2f} mm", flush=True)
     write_tables(out, rows)
     print(f"{source} -> {out}: {len(rows)} subjects")

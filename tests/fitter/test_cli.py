@@ -7,7 +7,7 @@ import pytest
 
 from bodyfit.fitter.cli import main
 from bodyfit.fitter.mesh_io import read_mesh, write_mesh
-from bodyfit.fitter.photo_extents import MAX_CHANGE, PHOTO_EXTENTS
+from bodyfit.fitter.photo_extents import MAX_CHANGE, SCALED
 
 
 def run(capsys, *argv):
@@ -73,7 +73,7 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     # than their bound (photo_extents: the fit's pinhole views take them)
     mesh = measurer.measure(read_mesh(out_dir / "fit" / "mesh_rest.ply", body_model.faces))
     for key in MEASUREMENTS:
-        if key in PHOTO_EXTENTS:
+        if key in SCALED:
             assert abs(fitted[key] / mesh[key] - 1) < MAX_CHANGE, key
         else:
             assert fitted[key] == pytest.approx(mesh[key], abs=0.01), key
