@@ -62,7 +62,8 @@ from bodyfit.fitter.body_model import PART_NAMES, BodyModel
 from bodyfit.fitter.sections import (mesh_edges, region_edges, section_axes, section_centre,
                                      section_points, tape_lengths)
 
-__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "BICEP_SECTIONS", "Measurer"]
+__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "BICEP_SECTIONS", "ACROSS",
+           "Measurer"]
 
 #: key -> (snake_case name, human name), in the paper's Fig. 10 order.
 MEASUREMENTS = {
@@ -96,7 +97,8 @@ _SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs"
                     "H.L": "upperarm.L", "H.R": "upperarm.R"}
 
 _UP = np.array([0.0, 0.0, 1.0])
-_ACROSS = np.array([1.0, 0.0, 0.0])  # a section's first axis: across, as a front photo shows
+#: Across the body (the model's x): a girth section's first axis, as a front photo shows it.
+ACROSS = np.array([1.0, 0.0, 0.0])
 _SIDES = ("L", "R")
 
 
@@ -225,13 +227,13 @@ class Measurer:
         photo does); ``vertices``: (V, 3) metres."""
         v = np.asarray(vertices, np.float64)
         origin, normal = self.girth_plane(v, key)
-        return section_points(v, self._edges[_SECTION_REGIONS[key]], origin, normal, _ACROSS)
+        return section_points(v, self._edges[_SECTION_REGIONS[key]], origin, normal, ACROSS)
 
     def girth_axes(self, vertices: np.ndarray, key: str) -> np.ndarray:
         """(2, 3) float64: the unit axes of :meth:`girth_section`'s frame (across the body,
         then front to back, in girth ``key``'s plane) in the body's frame; ``vertices``:
         (V, 3) metres."""
-        return section_axes(self.girth_plane(vertices, key)[1], _ACROSS)
+        return section_axes(self.girth_plane(vertices, key)[1], ACROSS)
 
     def acromions(self, vertices: np.ndarray) -> np.ndarray:
         """(2, 3) float64, metres: the left and right acromion landmarks of ``vertices``

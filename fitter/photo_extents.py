@@ -35,7 +35,7 @@ across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
   where the body's does not), or where the ratio strays beyond :data:`MAX_CHANGE` (hair
   or clothing, not the body, makes that outline).
 - Which measurements and views: chosen by measured error (docs/accuracy.md steps
-  28-29): the neck's, the chest's, the waist's and the hip's width from the front photo,
+  28-30): the neck's, the chest's, the waist's and the hip's width from the front photo,
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
   rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits),
@@ -56,15 +56,14 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
-from bodyfit.fitter.measurements import BICEP_SECTIONS, Measurer
+from bodyfit.fitter.measurements import ACROSS, BICEP_SECTIONS, Measurer
 from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "ViewPhoto",
-           "outline_width",
-           "placed_camera", "turned_to_tape", "extent_ratio", "section_scales",
-           "photo_scaled_measurements"]
+           "outline_width", "placed_camera", "turned_to_tape", "extent_ratio",
+           "section_scales", "photo_scaled_measurements"]
 
 #: tape key -> the views whose photo sets its extent ("front": across the body, a girth
 #: section's first axis; "side": front to back, its second): the girths of
@@ -80,14 +79,13 @@ MAX_CHANGE = 0.2
 SHOULDER_DROP_M = 0.02
 #: (key, view) -> its own parts: the rendered outline at the tape's rows must be of these.
 _OWN_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
-                ("D", "front"): ("chest",), ("E", "front"): ("waist",),
-                ("F", "front"): ("hip", "leg"), ("H.L", "front"): ("arm",),
-                ("H.R", "front"): ("arm",), ("P", "front"): ("arm",)}
+              ("D", "front"): ("chest",), ("E", "front"): ("waist",),
+              ("F", "front"): ("hip", "leg"), ("H.L", "front"): ("arm",),
+              ("H.R", "front"): ("arm",), ("P", "front"): ("arm",)}
 _BAND_ROWS = 2  # rows above and below the tape's centre row
 _SUBPIXELS = 4  # the body's render cuts each photo column into as many
 _MARGIN_PX = 8
 _AXES = {"front": 0, "side": 1}
-_ACROSS = np.array([1.0, 0.0, 0.0])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -154,7 +152,7 @@ def _tape_line(measurer: Measurer, body: np.ndarray, key: str,
     its axis of the view (:meth:`Measurer.girth_axes`); the shoulder breadth's point
     :data:`SHOULDER_DROP_M` below the acromions' midpoint, across the body."""
     if key == "P":
-        return measurer.acromions(body).mean(axis=0) - [0.0, 0.0, SHOULDER_DROP_M], _ACROSS
+        return measurer.acromions(body).mean(axis=0) - [0.0, 0.0, SHOULDER_DROP_M], ACROSS
     return measurer.girth_centre(body, key), measurer.girth_axes(body, key)[_AXES[view]]
 
 
@@ -272,7 +270,7 @@ def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.nda
     for key, scale in section_scales(model, measurer, photos).items():
         if key == "P":
             left, right = measurer.acromions(rest)
-            scaled[key] = 1000.0 * float(np.linalg.norm(left - right)) * scale[0]
+            scaled[key] = 1000.0 * float(np.linalg.norm(left - right) * scale[0])
         else:
             scaled[key] = 1000.0 * hull_perimeter(measurer.girth_section(rest, key) * scale)
     scaled["H"] = float(np.mean([scaled.pop(key) for key in BICEP_SECTIONS]))
