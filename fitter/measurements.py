@@ -62,7 +62,7 @@ from bodyfit.fitter.body_model import PART_NAMES, BodyModel
 from bodyfit.fitter.sections import (mesh_edges, region_edges, section_axes, section_centre,
                                      section_points, tape_lengths)
 
-__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "BICEP_SECTIONS", "ACROSS",
+__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "ARM_SECTIONS", "ACROSS",
            "Measurer"]
 
 #: key -> (snake_case name, human name), in the paper's Fig. 10 order.
@@ -90,11 +90,18 @@ IMPORTANT = ("B", "C", "D", "E", "F", "L", "P")
 #: The girths taken on one plane section (the others: the largest of several planes, or
 #: a limb's two sides), and the region each tape keeps to.
 SECTION_GIRTHS = ("B", "D", "E", "F")
-#: The bicep girth's two tapes, left and right (the bicep circumference is their mean):
-#: plane sections too (:meth:`Measurer.girth_plane` and the rest take these keys).
-BICEP_SECTIONS = ("H.L", "H.R")
-_SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs",
-                    "H.L": "upperarm.L", "H.R": "upperarm.R"}
+#: The arm's girths (wrist, bicep, forearm) -> their two tapes, left and right (the
+#: girth is their mean): plane sections too (:meth:`Measurer.girth_plane` and the rest
+#: take these keys).
+ARM_SECTIONS = {"G": ("G.L", "G.R"), "H": ("H.L", "H.R"), "I": ("I.L", "I.R")}
+#: An arm tape's limb (``_LIMBS``) and, for the forearm, where its candidate planes cross
+#: the limb's axis (0 at the elbow ring, 1 at the wrist ring: the largest girth is taken).
+_ARM_LIMBS = {"G": "wrist", "H": "upperarm", "I": "forearm"}
+_FOREARM_FRACTIONS = np.linspace(0.1, 0.4, 7)
+#: arm tape -> (its girth's key, its side)
+_ARM_TAPES = {tape: (key, tape[-1]) for key, tapes in ARM_SECTIONS.items() for tape in tapes}
+_SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs"} | {
+    tape: f"{_ARM_LIMBS[key]}.{side}" for tape, (key, side) in _ARM_TAPES.items()}
 
 _UP = np.array([0.0, 0.0, 1.0])
 #: Across the body (the model's x): a girth section's first axis, as a front photo shows it.
@@ -191,20 +198,30 @@ class Measurer:
         return tape_lengths(vertices, self._edges[region], origins, _UP)
 
     def girth_plane(self, vertices: np.ndarray, key: str) -> tuple[np.ndarray, np.ndarray]:
-        """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS`` or
-        ``BICEP_SECTIONS``) and (3,) its normal, on ``vertices`` (V, 3) metres, rest A-pose
-        or posed (the trunk and neck do not move with the pose's four angles, a bicep's
-        plane follows its arm). The neck's: midway between the neck's base and top rings,
-        perpendicular to the line joining them; the trunk's: horizontal; a bicep's:
-        perpendicular to the upper arm's axis (its shoulder ring's centre to its elbow
-        ring's), where the point midway between acromion and elbow projects onto it."""
+        """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS`` or an arm tape
+        of ``ARM_SECTIONS``) and (3,) its normal, on ``vertices`` (V, 3) metres, rest
+        A-pose or posed (the trunk and neck do not move with the pose's four angles, an arm
+        tape's plane follows its arm). The neck's: midway between the neck's base and top
+        rings, perpendicular to the line joining them; the trunk's: horizontal; an arm
+        tape's: perpendicular to its limb's axis (the proximal ring's centre to the
+        distal's), for the bicep where the point midway between acromion and elbow
+        projects onto it, for the wrist at the wrist ring, for the forearm at the largest
+        of the girths 10-40 % of the way from the elbow ring to the wrist ring."""
         v = np.asarray(vertices, np.float64)
-        if key in BICEP_SECTIONS:
-            side, spec = BICEP_SECTIONS.index(key), _LIMBS["upperarm"]
-            top = self._ring(v, spec.upper_ring, _SIDES[side])
-            bottom = self._ring(v, spec.lower_ring, _SIDES[side])
+        if key in _ARM_TAPES:
+            girth, side = _ARM_TAPES[key]
+            spec = _LIMBS[_ARM_LIMBS[girth]]
+            top = self._ring(v, spec.upper_ring, side)
+            bottom = self._ring(v, spec.lower_ring, side)
             axis = bottom - top
-            midway = 0.5 * (self.acromions(v)[side] + bottom)
+            if girth == "G":
+                return bottom, axis
+            if girth == "I":
+                girths = tape_lengths(v, self._edges[_SECTION_REGIONS[key]],
+                                      top + np.outer(_FOREARM_FRACTIONS, axis), axis)
+                largest = np.nanargmax(girths) if np.isfinite(girths).any() else 0
+                return top + _FOREARM_FRACTIONS[largest] * axis, axis
+            midway = 0.5 * (self.acromions(v)[_SIDES.index(side)] + bottom)
             return top + np.dot(midway - top, axis) / np.sum(axis ** 2) * axis, axis
         if key == "B":
             base, top = self._ring(v, "neck_base"), self._ring(v, "neck_top")
@@ -217,7 +234,7 @@ class Measurer:
             buttocks = v[self._buttock_vertices]
             height = buttocks[np.argmax(buttocks[:, 1]), 2]
         else:
-            raise KeyError(f"{key!r} is not one of {SECTION_GIRTHS + BICEP_SECTIONS}")
+            raise KeyError(f"{key!r} is neither one of {SECTION_GIRTHS} nor an arm tape")
         return np.array([0.0, 0.0, height]), _UP
 
     def girth_section(self, vertices: np.ndarray, key: str) -> np.ndarray:
@@ -271,11 +288,9 @@ class Measurer:
             out[key] = tape_lengths(v, self._edges[_SECTION_REGIONS[key]],
                                     *self.girth_plane(v, key))[0]
         out["C"] = acromion[:, 2].mean() - crotch[2]
-        out["G"] = self._limb_girths(v, "wrist", np.array([1.0]), np.nanmax)
-        out["H"] = np.mean([tape_lengths(v, self._edges[_SECTION_REGIONS[key]],
-                                         *self.girth_plane(v, key))[0]
-                            for key in BICEP_SECTIONS])
-        out["I"] = self._limb_girths(v, "forearm", np.linspace(0.1, 0.4, 7), np.nanmax)
+        for key, tapes in ARM_SECTIONS.items():
+            out[key] = np.mean([tape_lengths(v, self._edges[_SECTION_REGIONS[tape]],
+                                             *self.girth_plane(v, tape))[0] for tape in tapes])
         radiale, stylion = self._point(v, "radiale"), self._point(v, "stylion")
         out["J"] = float(np.mean(np.linalg.norm(acromion - radiale, axis=1)
                                  + np.linalg.norm(radiale - stylion, axis=1)))

@@ -56,23 +56,24 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
-from bodyfit.fitter.measurements import ACROSS, BICEP_SECTIONS, Measurer
+from bodyfit.fitter.measurements import ACROSS, ARM_SECTIONS, Measurer
 from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "ViewPhoto",
-           "outline_width", "placed_camera", "turned_to_tape", "extent_ratio",
-           "section_scales", "photo_scaled_measurements"]
+           "outline_width", "placed_camera", "silhouette_axis", "turned_to_tape",
+           "extent_ratio", "section_scales", "scaled_section", "photo_scaled_measurements"]
 
 #: tape key -> the views whose photo sets its extent ("front": across the body, a girth
 #: section's first axis; "side": front to back, its second): the girths of
-#: ``SECTION_GIRTHS``, the bicep's two tapes (``BICEP_SECTIONS``) and the shoulder
-#: breadth "P".
+#: ``SECTION_GIRTHS``, the bicep's and the forearm's tapes (``ARM_SECTIONS``, two each)
+#: and the shoulder breadth "P".
 PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
-                 "H.L": ("front",), "H.R": ("front",), "P": ("front",)}
+                 "H.L": ("front",), "H.R": ("front",), "I.L": ("front",), "I.R": ("front",),
+                 "P": ("front",)}
 #: The measurements (MEASUREMENTS keys) the photos scale.
-SCALED = ("B", "D", "E", "F", "H", "P")
+SCALED = ("B", "D", "E", "F", "H", "I", "P")
 #: The largest relative change of an extent the photos may make.
 MAX_CHANGE = 0.2
 #: The shoulder breadth's line lies this far (metres) below the acromions' midpoint.
@@ -80,12 +81,20 @@ SHOULDER_DROP_M = 0.02
 #: (key, view) -> its own parts: the rendered outline at the tape's rows must be of these.
 _OWN_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
               ("D", "front"): ("chest",), ("E", "front"): ("waist",),
-              ("F", "front"): ("hip", "leg"), ("H.L", "front"): ("arm",),
-              ("H.R", "front"): ("arm",), ("P", "front"): ("arm",)}
-_BAND_ROWS = 2  # rows above and below the tape's centre row
+              ("F", "front"): ("hip", "leg"), ("P", "front"): ("arm",),
+              ("H.L", "front"): ("arm",), ("H.R", "front"): ("arm",),
+              ("I.L", "front"): ("arm", "elbow"), ("I.R", "front"): ("arm", "elbow")}
+#: tape key -> the rows above and below its centre row whose widths are averaged
+#: (_OTHER_BAND elsewhere): the neck's and the shoulder breadth's features are short (chin
+#: and shoulders, the deltoids' rounding).
+_BAND_ROWS = {"B": 2, "P": 2}
+_OTHER_BAND = 6
 _SUBPIXELS = 4  # the body's render cuts each photo column into as many
 _MARGIN_PX = 8
 _AXES = {"front": 0, "side": 1}
+#: view -> its line of sight in the model's frame (the front camera looks along the
+#: model's y, the side camera along its x)
+_SIGHTS = {"front": np.array([0.0, 1.0, 0.0]), "side": np.array([1.0, 0.0, 0.0])}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -145,15 +154,25 @@ def placed_camera(model: BodyModel, photo: ViewPhoto) -> tuple[np.ndarray, np.nd
     return placement.extrinsics(photo.name)
 
 
+def silhouette_axis(measurer: Measurer, body: np.ndarray, key: str, view: str) -> np.ndarray:
+    """(3,) unit, body frame: the direction in girth ``key``'s plane (on ``body`` (V, 3)
+    metres) across the ``view``'s line of sight, along which the view's photo shows the
+    section's extent: the trunk's and the neck's first section axis (across the body) in
+    the front view, their second (front to back) in the side view; an arm tape's lies
+    between, its limb not in the photo's plane (the A-pose's forearm reaches forward)."""
+    axis = np.cross(measurer.girth_plane(body, key)[1], _SIGHTS[view])
+    return axis / np.linalg.norm(axis)
+
+
 def _tape_line(measurer: Measurer, body: np.ndarray, key: str,
                view: str) -> tuple[np.ndarray, np.ndarray]:
     """((3,) centre, (3,) unit direction), metres, body frame: where measurement ``key``'s
     extent is read on ``body`` (V, 3) in the ``view``'s photo: a girth's section centre and
-    its axis of the view (:meth:`Measurer.girth_axes`); the shoulder breadth's point
-    :data:`SHOULDER_DROP_M` below the acromions' midpoint, across the body."""
+    its :func:`silhouette_axis`; the shoulder breadth's point :data:`SHOULDER_DROP_M` below
+    the acromions' midpoint, across the body."""
     if key == "P":
         return measurer.acromions(body).mean(axis=0) - [0.0, 0.0, SHOULDER_DROP_M], ACROSS
-    return measurer.girth_centre(body, key), measurer.girth_axes(body, key)[_AXES[view]]
+    return measurer.girth_centre(body, key), silhouette_axis(measurer, body, key, view)
 
 
 def turned_to_tape(measurer: Measurer, key: str, photo: ViewPhoto,
@@ -215,9 +234,10 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhot
     u, v = (k[:2, :2] @ (cam[:2] / cam[2])) + k[:2, 2]
     height, width = photo.mask.shape
     row = int(round(v))
-    if not _BAND_ROWS <= row < height - _BAND_ROWS:
+    band = _BAND_ROWS.get(key, _OTHER_BAND)
+    if not band <= row < height - band:
         return None
-    rows = range(row - _BAND_ROWS, row + _BAND_ROWS + 1)
+    rows = range(row - band, row + band + 1)
     mask_cols = np.flatnonzero(photo.mask[rows.start:rows.stop].any(axis=0))
     if len(mask_cols) == 0:
         return None
@@ -242,9 +262,9 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhot
 
 def section_scales(model: BodyModel, measurer: Measurer,
                    photos: dict[str, ViewPhoto]) -> dict[str, np.ndarray]:
-    """key -> (2,) the factors of the measurements of :data:`PHOTO_EXTENTS` on their
-    extents (across the body, front to back; the shoulder breadth's second unused): each
-    the :func:`extent_ratio` of its view's photo in ``photos`` (views missing there:
+    """key -> (2,) the factors of the measurements of :data:`PHOTO_EXTENTS` along their
+    front and side views' :func:`silhouette_axis` (the shoulder breadth's second unused):
+    each the :func:`extent_ratio` of its view's photo in ``photos`` (views missing there:
     none), turned to the tape (:func:`turned_to_tape`), 1 where none applies; each view's
     camera placed once."""
     cameras = {name: placed_camera(model, photo) for name, photo in photos.items()}
@@ -259,19 +279,34 @@ def section_scales(model: BodyModel, measurer: Measurer,
     return scales
 
 
+def scaled_section(measurer: Measurer, rest: np.ndarray, key: str,
+                   scale: np.ndarray) -> np.ndarray:
+    """(n, 2) metres: girth ``key``'s section of ``rest`` (V, 3) metres
+    (:meth:`Measurer.girth_section`) stretched by the factors ``scale`` (2,) along its
+    front and side views' :func:`silhouette_axis` in turn."""
+    section = measurer.girth_section(rest, key)
+    frame = measurer.girth_axes(rest, key)
+    for view, factor in zip(_AXES, scale):
+        axis = frame @ silhouette_axis(measurer, rest, key, view)
+        section = section + (factor - 1.0) * np.outer(section @ axis, axis)
+    return section
+
+
 def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.ndarray,
                               photos: dict[str, ViewPhoto]) -> dict[str, float]:
     """key -> mm: the measurements :data:`SCALED` of the fitted body ``rest`` (V, 3)
     metres (rest A-pose, at the person's stature), their tapes of :data:`PHOTO_EXTENTS`
-    scaled by their :func:`section_scales`: a girth its section (the bicep: the mean of
-    its two), the shoulder breadth its length (a tape no ratio applies to keeps its
-    fitted value)."""
+    scaled by their :func:`section_scales`: a girth its section (:func:`scaled_section`;
+    an arm's girth: the mean of its two), the shoulder breadth its length (a tape no ratio
+    applies to keeps its fitted value)."""
     scaled = {}
     for key, scale in section_scales(model, measurer, photos).items():
         if key == "P":
             left, right = measurer.acromions(rest)
             scaled[key] = 1000.0 * float(np.linalg.norm(left - right) * scale[0])
         else:
-            scaled[key] = 1000.0 * hull_perimeter(measurer.girth_section(rest, key) * scale)
-    scaled["H"] = float(np.mean([scaled.pop(key) for key in BICEP_SECTIONS]))
+            scaled[key] = 1000.0 * hull_perimeter(scaled_section(measurer, rest, key, scale))
+    for key, tapes in ARM_SECTIONS.items():
+        if key in SCALED:
+            scaled[key] = float(np.mean([scaled.pop(tape) for tape in tapes]))
     return scaled
