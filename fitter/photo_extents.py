@@ -8,10 +8,12 @@ numbers", steps 26 and 28). The photo itself shows that width at its own resolut
 for the girths of :data:`PHOTO_EXTENTS`, after the fit, each listed view's photo is
 compared with the fitted body rendered through the same camera at the photo's resolution:
 the ratio of the person's outline width to the body's, averaged over the lines along the
-tape around its centre, scales the fitted section along that view's axis (the front
-view's across the body, the side view's front to back), and the tape is the scaled
-section's convex hull. The bicep's two tapes are scaled each by its arm's width across
-its tape in the front photo, the bicep circumference their mean. The shoulder breadth
+tape around its centre, scales the fitted section along that view's silhouette axis
+(:func:`silhouette_axis`, the direction in the tape's plane across the view's line of
+sight: for the trunk and neck the front view's is across the body, the side view's front
+to back), and the tape is the scaled section's convex hull. The bicep's and the
+forearm's two tapes are scaled each by its arm's width across its tape in the front
+photo, the girth their mean. The shoulder breadth
 (the acromions' distance) is scaled the same way, by the front photo's outline width
 across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
 
@@ -19,14 +21,17 @@ across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
   :func:`~bodyfit.fitter.pinhole_canvas.solve_placement`), so the body's crown and toes
   fall on the silhouette's top and bottom rows and the tape's rows are the person's.
 - The view is first turned about its camera's optical axis (:func:`turned_to_tape`) so
-  that the tape's line in the photo, its section's axis of that view, runs along a row:
+  that the tape's line in the photo, its silhouette axis through its centre, runs along
+  a row:
   the front photo's trunk tapes lie along its rows already, the side photo's neck tape is
   tilted 8-15 degrees, down towards the throat, and a row through its centre would meet
   the chin.
 - A width is the foreground run of a (turned) photo row that holds the projected
   section's centre (or lies nearest it), in the person's mask and in the body's render
-  alike; only the band of rows around the tape is rendered (a crop of the camera), so
-  photos of any size cost the same.
+  alike, averaged over 6 rows either side of the tape's (2 for the neck, between chin
+  and shoulders, and the shoulder breadth, on the deltoids' rounding: 6 came out better
+  than 2 or 4 for the others on the same fits, if within noise); only the band of rows around the tape
+  is rendered (a crop of the camera), so photos of any size cost the same.
 - The scaling is skipped (the fitted value kept) where the rendered body's outline at
   those rows is not the measurement's own part (an arm against the chest, the jaw over
   the neck in the front photo; in the side photo the jaw's underside, the head's part,
@@ -35,13 +40,15 @@ across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
   where the body's does not), or where the ratio strays beyond :data:`MAX_CHANGE` (hair
   or clothing, not the body, makes that outline).
 - Which measurements and views: chosen by measured error (docs/accuracy.md steps
-  28-30): the neck's, the chest's, the waist's and the hip's width from the front photo,
+  28-31): the neck's, the chest's, the waist's and the hip's width from the front photo,
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
   rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits),
-  the bicep's width from the front photo (its tape tilted with the A-pose's arm). The
-  trunk's side depths lost in-space (the hip's holds the hands); the side photo's arms
-  hang against the body; the other limbs' girths are not scaled.
+  the bicep's and the forearm's width from the front photo (their tapes tilted with the
+  A-pose's arm; the forearm reaches forward, so its silhouette axis is some 30 degrees
+  off the section's first). The trunk's side depths lost in-space (the hip's holds the
+  hands); the wrist's tape lies where the thumb starts and lost on both sets; the side
+  photo's arms hang against the body; the legs' girths are not scaled.
 
 Pinhole views only (the photos' own camera); the paper's orthographic method measures
 the fitted mesh alone.
