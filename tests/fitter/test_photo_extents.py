@@ -129,6 +129,22 @@ def test_the_shoulder_breadth_follows_the_photo(body_model, measurer, mean_body,
     assert true == pytest.approx(fitted * factor)
 
 
+def test_the_silhouette_axis_lies_in_the_tape_across_the_line_of_sight(measurer, mean_body):
+    """The trunk's tapes are horizontal: the front photo sees their extent across the body
+    (x), the side photo front to back (y). The A-pose's forearm reaches forward: its axis
+    lies in the tape's plane, across the front camera's line of sight (y), and some
+    degrees off the section's first axis."""
+    posed, _ = mean_body
+    for view, expected in (("front", [1.0, 0.0, 0.0]), ("side", [0.0, 1.0, 0.0])):
+        assert abs(silhouette_axis(measurer, posed, "D", view) @ expected) == pytest.approx(1.0)
+    axis = silhouette_axis(measurer, posed, "I.L", "front")
+    normal = measurer.girth_plane(posed, "I.L")[1]
+    assert axis @ normal == pytest.approx(0.0, abs=1e-9)
+    assert axis[1] == pytest.approx(0.0, abs=1e-9)
+    assert np.linalg.norm(axis) == pytest.approx(1.0)
+    assert abs(axis @ measurer.girth_axes(posed, "I.L")[0]) < np.cos(np.radians(10))
+
+
 #: an arm girth -> the regions its tapes widen (each side's)
 _ARM_REGIONS = {"H": ("upperarm",), "I": ("forearm",)}
 
