@@ -29,9 +29,10 @@ across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
 - A width is the foreground run of a (turned) photo row that holds the projected
   section's centre (or lies nearest it), in the person's mask and in the body's render
   alike, averaged over 6 rows either side of the tape's (2 for the neck, between chin
-  and shoulders, and the shoulder breadth, on the deltoids' rounding: 6 came out better
-  than 2 or 4 for the others on the same fits, if within noise); only the band of rows around the tape
-  is rendered (a crop of the camera), so photos of any size cost the same.
+  and shoulders, and the shoulder breadth, on the deltoids' rounding; for the others 6
+  came out better than 2 or 4 on the same fits, if within noise); only the band of rows
+  around the tape is rendered (a crop of the camera), so photos of any size cost the
+  same.
 - The scaling is skipped (the fitted value kept) where the rendered body's outline at
   those rows is not the measurement's own part (an arm against the chest, the jaw over
   the neck in the front photo; in the side photo the jaw's underside, the head's part,
@@ -72,8 +73,9 @@ __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "ViewPhot
            "outline_width", "placed_camera", "silhouette_axis", "turned_to_tape",
            "extent_ratio", "section_scales", "scaled_section", "photo_scaled_measurements"]
 
-#: tape key -> the views whose photo sets its extent ("front": across the body, a girth
-#: section's first axis; "side": front to back, its second): the girths of
+#: tape key -> the views whose photo sets its extent (along the view's
+#: :func:`silhouette_axis`: for the trunk and neck "front" is across the body, "side"
+#: front to back): the girths of
 #: ``SECTION_GIRTHS``, the bicep's and the forearm's tapes (``ARM_SECTIONS``, two each)
 #: and the shoulder breadth "P".
 PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
