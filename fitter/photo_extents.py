@@ -11,9 +11,10 @@ the ratio of the person's outline width to the body's, averaged over the lines a
 tape around its centre, scales the fitted section along that view's silhouette axis
 (:func:`silhouette_axis`, the direction in the tape's plane across the view's line of
 sight: for the trunk and neck the front view's is across the body, the side view's front
-to back), and the tape is the scaled section's convex hull. The bicep's and the
-forearm's two tapes are scaled each by its arm's width across its tape in the front
-photo, the girth their mean. The shoulder breadth
+to back), and the tape is the scaled section's convex hull. The wrist's, the bicep's and
+the forearm's two tapes are scaled each by its arm's width across its tape in the front
+photo (the wrist's read :data:`WRIST_RISE_M` up the forearm), the girth their mean. The
+shoulder breadth
 (the acromions' distance) is scaled the same way, by the front photo's outline width
 across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
 
@@ -45,10 +46,11 @@ across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
   rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits),
-  the bicep's and the forearm's width from the front photo (their tapes tilted with the
-  A-pose's arm; the forearm reaches forward, so its silhouette axis is some 30 degrees
-  off the section's first). The trunk's side depths lost in-space (the hip's holds the
-  hands); the wrist's tape lies where the thumb starts and lost on both sets; the side
+  the bicep's, the forearm's and the wrist's width from the front photo (their tapes
+  tilted with the A-pose's arm; the forearm reaches forward, so its silhouette axis is
+  some 30 degrees off the section's first; the wrist's tape lies where the thumb starts,
+  and read there it lost on both sets: 3 cm up the forearm came out better than 1.5 or
+  4.5). The trunk's side depths lost in-space (the hip's holds the hands); the side
   photo's arms hang against the body; the legs' girths are not scaled.
 
 Pinhole views only (the photos' own camera); the paper's orthographic method measures
@@ -69,30 +71,34 @@ from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "ViewPhoto",
-           "outline_width", "placed_camera", "silhouette_axis", "turned_to_tape",
+__all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "WRIST_RISE_M",
+           "ViewPhoto", "outline_width", "placed_camera", "silhouette_axis", "turned_to_tape",
            "extent_ratio", "section_scales", "scaled_section", "photo_scaled_measurements"]
 
 #: tape key -> the views whose photo sets its extent (along the view's
 #: :func:`silhouette_axis`: for the trunk and neck "front" is across the body, "side"
 #: front to back): the girths of
-#: ``SECTION_GIRTHS``, the bicep's and the forearm's tapes (``ARM_SECTIONS``, two each)
-#: and the shoulder breadth "P".
+#: ``SECTION_GIRTHS``, the arm's tapes (``ARM_SECTIONS``: wrist, bicep, forearm, two
+#: each) and the shoulder breadth "P".
 PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
-                 "H.L": ("front",), "H.R": ("front",), "I.L": ("front",), "I.R": ("front",),
-                 "P": ("front",)}
+                 "G.L": ("front",), "G.R": ("front",), "H.L": ("front",), "H.R": ("front",),
+                 "I.L": ("front",), "I.R": ("front",), "P": ("front",)}
 #: The measurements (MEASUREMENTS keys) the photos scale.
-SCALED = ("B", "D", "E", "F", "H", "I", "P")
+SCALED = ("B", "D", "E", "F", "G", "H", "I", "P")
 #: The largest relative change of an extent the photos may make.
 MAX_CHANGE = 0.2
 #: The shoulder breadth's line lies this far (metres) below the acromions' midpoint.
 SHOULDER_DROP_M = 0.02
+#: The wrist's width is read this far (metres) up the forearm from its tape, whose rows
+#: the thumb's base crosses; the ratio there scales the wrist's section.
+WRIST_RISE_M = 0.03
 #: (key, view) -> its own parts: the rendered outline at the tape's rows must be of these.
 _OWN_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
               ("D", "front"): ("chest",), ("E", "front"): ("waist",),
               ("F", "front"): ("hip", "leg"), ("P", "front"): ("arm",),
               ("H.L", "front"): ("arm",), ("H.R", "front"): ("arm",),
-              ("I.L", "front"): ("arm", "elbow"), ("I.R", "front"): ("arm", "elbow")}
+              ("I.L", "front"): ("arm", "elbow"), ("I.R", "front"): ("arm", "elbow"),
+              ("G.L", "front"): ("elbow", "hand"), ("G.R", "front"): ("elbow", "hand")}
 #: tape key -> the rows above and below its centre row whose widths are averaged
 #: (_OTHER_BAND elsewhere): the neck's and the shoulder breadth's features are short (chin
 #: and shoulders, the deltoids' rounding).
@@ -177,11 +183,16 @@ def _tape_line(measurer: Measurer, body: np.ndarray, key: str,
                view: str) -> tuple[np.ndarray, np.ndarray]:
     """((3,) centre, (3,) unit direction), metres, body frame: where measurement ``key``'s
     extent is read on ``body`` (V, 3) in the ``view``'s photo: a girth's section centre and
-    its :func:`silhouette_axis`; the shoulder breadth's point :data:`SHOULDER_DROP_M` below
-    the acromions' midpoint, across the body."""
+    its :func:`silhouette_axis` (the wrist's centre moved :data:`WRIST_RISE_M` up the
+    forearm); the shoulder breadth's point :data:`SHOULDER_DROP_M` below the acromions'
+    midpoint, across the body."""
     if key == "P":
         return measurer.acromions(body).mean(axis=0) - [0.0, 0.0, SHOULDER_DROP_M], ACROSS
-    return measurer.girth_centre(body, key), silhouette_axis(measurer, body, key, view)
+    centre = measurer.girth_centre(body, key)
+    if key in ARM_SECTIONS["G"]:
+        towards_wrist = measurer.girth_plane(body, key)[1]
+        centre = centre - WRIST_RISE_M * towards_wrist / np.linalg.norm(towards_wrist)
+    return centre, silhouette_axis(measurer, body, key, view)
 
 
 def turned_to_tape(measurer: Measurer, key: str, photo: ViewPhoto,
@@ -316,6 +327,5 @@ def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.nda
         else:
             scaled[key] = 1000.0 * hull_perimeter(scaled_section(measurer, rest, key, scale))
     for key, tapes in ARM_SECTIONS.items():
-        if key in SCALED:
-            scaled[key] = float(np.mean([scaled.pop(tape) for tape in tapes]))
+        scaled[key] = float(np.mean([scaled.pop(tape) for tape in tapes]))
     return scaled
