@@ -237,6 +237,12 @@ class Measurer:
             raise KeyError(f"{key!r} is neither one of {SECTION_GIRTHS} nor an arm tape")
         return np.array([0.0, 0.0, height]), _UP
 
+    def _plane_girth(self, vertices: np.ndarray, key: str) -> float:
+        """Metres: girth ``key``'s tape (:meth:`girth_plane`'s section of its region);
+        NaN where the plane misses it."""
+        return tape_lengths(vertices, self._edges[_SECTION_REGIONS[key]],
+                            *self.girth_plane(vertices, key))[0]
+
     def girth_section(self, vertices: np.ndarray, key: str) -> np.ndarray:
         """(n, 2) float64, metres: the points where girth ``key``'s plane
         (:meth:`girth_plane`) cuts its region (whose convex hull is the tape), across the
@@ -285,12 +291,10 @@ class Measurer:
         out["A"] = np.nanmax(self._horizontal_girth(
             v, "skull", neck_top[2] + span * np.linspace(0.5, 0.8, 7)))
         for key in SECTION_GIRTHS:
-            out[key] = tape_lengths(v, self._edges[_SECTION_REGIONS[key]],
-                                    *self.girth_plane(v, key))[0]
+            out[key] = self._plane_girth(v, key)
         out["C"] = acromion[:, 2].mean() - crotch[2]
         for key, tapes in ARM_SECTIONS.items():
-            out[key] = np.mean([tape_lengths(v, self._edges[_SECTION_REGIONS[tape]],
-                                             *self.girth_plane(v, tape))[0] for tape in tapes])
+            out[key] = np.mean([self._plane_girth(v, tape) for tape in tapes])
         radiale, stylion = self._point(v, "radiale"), self._point(v, "stylion")
         out["J"] = float(np.mean(np.linalg.norm(acromion - radiale, axis=1)
                                  + np.linalg.norm(radiale - stylion, axis=1)))

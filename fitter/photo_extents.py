@@ -83,8 +83,9 @@ __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "WRIST_RI
 PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
                  "G.L": ("front",), "G.R": ("front",), "H.L": ("front",), "H.R": ("front",),
                  "I.L": ("front",), "I.R": ("front",), "P": ("front",)}
-#: The measurements (MEASUREMENTS keys) the photos scale.
-SCALED = ("B", "D", "E", "F", "G", "H", "I", "P")
+#: The measurements (MEASUREMENTS keys) the photos scale: a tape key's part before its
+#: ".L"/".R".
+SCALED = tuple(dict.fromkeys(tape.split(".")[0] for tape in PHOTO_EXTENTS))
 #: The largest relative change of an extent the photos may make.
 MAX_CHANGE = 0.2
 #: The shoulder breadth's line lies this far (metres) below the acromions' midpoint.
@@ -319,13 +320,12 @@ def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.nda
     scaled by their :func:`section_scales`: a girth its section (:func:`scaled_section`;
     an arm's girth: the mean of its two), the shoulder breadth its length (a tape no ratio
     applies to keeps its fitted value)."""
-    scaled = {}
-    for key, scale in section_scales(model, measurer, photos).items():
-        if key == "P":
+    tapes: dict[str, list[float]] = {}  # measurement -> its tapes' values, mm
+    for tape, scale in section_scales(model, measurer, photos).items():
+        if tape == "P":
             left, right = measurer.acromions(rest)
-            scaled[key] = 1000.0 * float(np.linalg.norm(left - right) * scale[0])
+            value = float(np.linalg.norm(left - right) * scale[0])
         else:
-            scaled[key] = 1000.0 * hull_perimeter(scaled_section(measurer, rest, key, scale))
-    for key, tapes in ARM_SECTIONS.items():
-        scaled[key] = float(np.mean([scaled.pop(tape) for tape in tapes]))
-    return scaled
+            value = hull_perimeter(scaled_section(measurer, rest, tape, scale))
+        tapes.setdefault(tape.split(".")[0], []).append(1000.0 * value)
+    return {key: float(np.mean(values)) for key, values in tapes.items()}
