@@ -62,7 +62,7 @@ from bodyfit.fitter.body_model import PART_NAMES, BodyModel
 from bodyfit.fitter.sections import (mesh_edges, region_edges, section_axes, section_centre,
                                      section_points, tape_lengths)
 
-__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "ARM_SECTIONS", "ACROSS",
+__all__ = ["MEASUREMENTS", "IMPORTANT", "SECTION_GIRTHS", "LIMB_SECTIONS", "ACROSS",
            "Measurer"]
 
 #: key -> (snake_case name, human name), in the paper's Fig. 10 order.
@@ -90,18 +90,23 @@ IMPORTANT = ("B", "C", "D", "E", "F", "L", "P")
 #: The girths taken on one plane section (the others: the largest of several planes, or
 #: a limb's two sides), and the region each tape keeps to.
 SECTION_GIRTHS = ("B", "D", "E", "F")
-#: The arm's girths (wrist, bicep, forearm) -> their two tapes, left and right (the
-#: girth is their mean): plane sections too (:meth:`Measurer.girth_plane` and the rest
-#: take these keys).
-ARM_SECTIONS = {"G": ("G.L", "G.R"), "H": ("H.L", "H.R"), "I": ("I.L", "I.R")}
-#: An arm tape's limb (``_LIMBS``) and, for the forearm, where its candidate planes cross
-#: the limb's axis (0 at the elbow ring, 1 at the wrist ring: the largest girth is taken).
-_ARM_LIMBS = {"G": "wrist", "H": "upperarm", "I": "forearm"}
-_FOREARM_FRACTIONS = np.linspace(0.1, 0.4, 7)
-#: arm tape -> (its girth's key, its side)
-_ARM_TAPES = {tape: (key, tape[-1]) for key, tapes in ARM_SECTIONS.items() for tape in tapes}
+#: The limbs' girths (wrist, bicep, forearm, thigh, calf, ankle) -> their two tapes, left
+#: and right (the girth is their mean): plane sections too (:meth:`Measurer.girth_plane`
+#: and the rest take these keys).
+LIMB_SECTIONS = {key: (f"{key}.L", f"{key}.R") for key in "GHILMN"}
+#: limb girth -> its limb (``_LIMBS``)
+_GIRTH_LIMBS = {"G": "wrist", "H": "upperarm", "I": "forearm", "L": "thigh", "M": "shank",
+                "N": "shank"}
+#: limb girth -> where its candidate planes cross the limb's axis (0 at the proximal ring,
+#: 1 at the distal) and which of their girths is the tape (the others: one plane,
+#: :meth:`Measurer.girth_plane`)
+_GIRTH_SPANS = {"I": (np.linspace(0.1, 0.4, 7), np.nanargmax),
+                "M": (np.linspace(0.2, 0.5, 7), np.nanargmax),
+                "N": (np.linspace(0.75, 0.92, 6), np.nanargmin)}
+#: limb tape -> (its girth's key, its side)
+_LIMB_TAPES = {tape: (key, tape[-1]) for key, tapes in LIMB_SECTIONS.items() for tape in tapes}
 _SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs"} | {
-    tape: f"{_ARM_LIMBS[key]}.{side}" for tape, (key, side) in _ARM_TAPES.items()}
+    tape: f"{_GIRTH_LIMBS[key]}.{side}" for tape, (key, side) in _LIMB_TAPES.items()}
 
 _UP = np.array([0.0, 0.0, 1.0])
 #: Across the body (the model's x): a girth section's first axis, as a front photo shows it.
@@ -172,57 +177,52 @@ class Measurer:
         key = f"ring:{joint}.{side}" if side else f"ring:{joint}"
         return vertices[self.landmarks[key]].astype(np.float64).mean(axis=0)
 
-    def _limb_girths(self, vertices: np.ndarray, limb: str, fractions, reduce) -> float:
-        """Mean over both sides of ``reduce`` over girths perpendicular to the limb axis.
-
-        The planes cross the axis (0 = proximal ring centroid, 1 = distal) at
-        ``fractions``: an (n,) array, or a function (proximal (3,), distal (3,), side
-        index) -> (n,) array for planes placed per side.
-        """
-        spec = _LIMBS[limb]
-        values = []
-        for i, side in enumerate(_SIDES):
-            top = self._ring(vertices, spec.upper_ring, side)
-            bottom = self._ring(vertices, spec.lower_ring, side)
-            axis = bottom - top
-            where = np.atleast_1d(fractions(top, bottom, i) if callable(fractions) else fractions)
-            girths = tape_lengths(vertices, self._edges[f"{limb}.{side}"],
-                                  top + np.outer(where, axis), axis)
-            values.append(reduce(girths))
-        return float(np.mean(values))
-
     def _horizontal_girth(self, vertices: np.ndarray, region: str, heights) -> np.ndarray:
         heights = np.atleast_1d(heights)
         origins = np.zeros((len(heights), 3))
         origins[:, 2] = heights
         return tape_lengths(vertices, self._edges[region], origins, _UP)
 
+    def _limb_fraction(self, v: np.ndarray, girth: str, side: str, top: np.ndarray,
+                       bottom: np.ndarray) -> float:
+        """Where the one plane of limb girth ``girth`` ("G", "H" or "L") crosses its limb's
+        axis from ``top`` (3,) to ``bottom`` (3,) on ``side``, 0 at ``top``, 1 at
+        ``bottom``: the wrist at the wrist ring, the bicep where the point midway between
+        acromion and elbow ring projects, the thigh where the axis passes 2 % of stature
+        below the crotch."""
+        if girth == "G":
+            return 1.0
+        axis = bottom - top
+        if girth == "H":
+            midway = 0.5 * (self.acromions(v)[_SIDES.index(side)] + bottom)
+            return float(np.dot(midway - top, axis) / np.sum(axis ** 2))
+        fold = self._point(v, "crotch")[0, 2] - 0.02 * (v[:, 2].max() - v[:, 2].min())
+        return float((top[2] - fold) / (top[2] - bottom[2]))
+
     def girth_plane(self, vertices: np.ndarray, key: str) -> tuple[np.ndarray, np.ndarray]:
-        """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS`` or an arm tape
-        of ``ARM_SECTIONS``) and (3,) its normal, on ``vertices`` (V, 3) metres, rest
-        A-pose or posed (the trunk and neck do not move with the pose's four angles, an arm
-        tape's plane follows its arm). The neck's: midway between the neck's base and top
-        rings, perpendicular to the line joining them; the trunk's: horizontal; an arm
+        """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS`` or a limb tape
+        of ``LIMB_SECTIONS``) and (3,) its normal, on ``vertices`` (V, 3) metres, rest
+        A-pose or posed (the trunk and neck do not move with the pose's four angles, a limb
+        tape's plane follows its limb). The neck's: midway between the neck's base and top
+        rings, perpendicular to the line joining them; the trunk's: horizontal; a limb
         tape's: perpendicular to its limb's axis (the proximal ring's centre to the
-        distal's), for the bicep where the point midway between acromion and elbow
-        projects onto it, for the wrist at the wrist ring, for the forearm at the largest
-        of the girths 10-40 % of the way from the elbow ring to the wrist ring."""
+        distal's), for the forearm and the calf at the largest, for the ankle at the
+        smallest of the girths over their spans (``_GIRTH_SPANS``), for the others
+        where :meth:`_limb_fraction` says."""
         v = np.asarray(vertices, np.float64)
-        if key in _ARM_TAPES:
-            girth, side = _ARM_TAPES[key]
-            spec = _LIMBS[_ARM_LIMBS[girth]]
+        if key in _LIMB_TAPES:
+            girth, side = _LIMB_TAPES[key]
+            spec = _LIMBS[_GIRTH_LIMBS[girth]]
             top = self._ring(v, spec.upper_ring, side)
             bottom = self._ring(v, spec.lower_ring, side)
             axis = bottom - top
-            if girth == "G":
-                return bottom, axis
-            if girth == "I":
+            if girth in _GIRTH_SPANS:
+                fractions, pick = _GIRTH_SPANS[girth]
                 girths = tape_lengths(v, self._edges[_SECTION_REGIONS[key]],
-                                      top + np.outer(_FOREARM_FRACTIONS, axis), axis)
-                largest = np.nanargmax(girths) if np.isfinite(girths).any() else 0
-                return top + _FOREARM_FRACTIONS[largest] * axis, axis
-            midway = 0.5 * (self.acromions(v)[_SIDES.index(side)] + bottom)
-            return top + np.dot(midway - top, axis) / np.sum(axis ** 2) * axis, axis
+                                      top + np.outer(fractions, axis), axis)
+                chosen = pick(girths) if np.isfinite(girths).any() else 0
+                return top + fractions[chosen] * axis, axis
+            return top + self._limb_fraction(v, girth, side, top, bottom) * axis, axis
         if key == "B":
             base, top = self._ring(v, "neck_base"), self._ring(v, "neck_top")
             return 0.5 * (base + top), top - base
@@ -234,7 +234,7 @@ class Measurer:
             buttocks = v[self._buttock_vertices]
             height = buttocks[np.argmax(buttocks[:, 1]), 2]
         else:
-            raise KeyError(f"{key!r} is neither one of {SECTION_GIRTHS} nor an arm tape")
+            raise KeyError(f"{key!r} is neither one of {SECTION_GIRTHS} nor a limb tape")
         return np.array([0.0, 0.0, height]), _UP
 
     def _plane_girth(self, vertices: np.ndarray, key: str) -> float:
@@ -293,18 +293,12 @@ class Measurer:
         for key in SECTION_GIRTHS:
             out[key] = self._plane_girth(v, key)
         out["C"] = acromion[:, 2].mean() - crotch[2]
-        for key, tapes in ARM_SECTIONS.items():
+        for key, tapes in LIMB_SECTIONS.items():
             out[key] = np.mean([self._plane_girth(v, tape) for tape in tapes])
         radiale, stylion = self._point(v, "radiale"), self._point(v, "stylion")
         out["J"] = float(np.mean(np.linalg.norm(acromion - radiale, axis=1)
                                  + np.linalg.norm(radiale - stylion, axis=1)))
         out["K"] = crotch[2] - floor
-        fold = crotch[2] - 0.02 * stature  # where each thigh's axis passes this height
-        out["L"] = self._limb_girths(v, "thigh",
-                                     lambda top, bottom, i: (top[2] - fold) / (top[2] - bottom[2]),
-                                     np.nanmax)
-        out["M"] = self._limb_girths(v, "shank", np.linspace(0.2, 0.5, 7), np.nanmax)
-        out["N"] = self._limb_girths(v, "shank", np.linspace(0.75, 0.92, 6), np.nanmin)
         out["O"] = stature
         out["P"] = float(np.linalg.norm(acromion[0] - acromion[1]))
         return {k: float(out[k]) * 1000.0 for k in MEASUREMENTS}

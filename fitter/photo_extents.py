@@ -13,10 +13,10 @@ tape around its centre, scales the fitted section along that view's silhouette a
 sight: for the trunk and neck the front view's is across the body, the side view's front
 to back), and the tape is the scaled section's convex hull. The wrist's, the bicep's and
 the forearm's two tapes are scaled each by its arm's width across its tape in the front
-photo (the wrist's read :data:`WRIST_RISE_M` up the forearm), the girth their mean. The
-shoulder breadth
-(the acromions' distance) is scaled the same way, by the front photo's outline width
-across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
+photo (the wrist's read :data:`WRIST_RISE_M` up the forearm), the calf's and the ankle's
+by its leg's, the girth their mean. The shoulder breadth (the acromions' distance) is
+scaled the same way, by the front photo's outline width across the deltoids
+:data:`SHOULDER_DROP_M` below the acromions.
 
 - The camera is placed from the fitted body in the view's pose (as the search places it:
   :func:`~bodyfit.fitter.pinhole_canvas.solve_placement`), so the body's crown and toes
@@ -50,8 +50,11 @@ across the deltoids :data:`SHOULDER_DROP_M` below the acromions.
   tilted with the A-pose's arm; the forearm reaches forward, so its silhouette axis is
   some 30 degrees off the section's first; the wrist's tape lies where the thumb starts,
   and read there it lost on both sets: 3 cm up the forearm came out better than 1.5 or
-  4.5). The trunk's side depths lost in-space (the hip's holds the hands); the side
-  photo's arms hang against the body; the legs' girths are not scaled.
+  4.5), the calf's and the ankle's width from the front photo (the A-pose's legs stand
+  apart; step 32). The trunk's side depths lost in-space (the hip's holds the hands); the
+  side photo's arms hang against the body and its legs overlap; the thigh's front width
+  lost out-of-space (at the gluteal fold the outline's outer end is the buttock's), so
+  the thigh is not scaled.
 
 Pinhole views only (the photos' own camera); the paper's orthographic method measures
 the fitted mesh alone.
@@ -66,7 +69,7 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, BodyModel
-from bodyfit.fitter.measurements import ACROSS, ARM_SECTIONS, Measurer
+from bodyfit.fitter.measurements import ACROSS, LIMB_SECTIONS, Measurer
 from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
@@ -78,11 +81,12 @@ __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "WRIST_RI
 #: tape key -> the views whose photo sets its extent (along the view's
 #: :func:`silhouette_axis`: for the trunk and neck "front" is across the body, "side"
 #: front to back): the girths of
-#: ``SECTION_GIRTHS``, the arm's tapes (``ARM_SECTIONS``: wrist, bicep, forearm, two
-#: each) and the shoulder breadth "P".
+#: ``SECTION_GIRTHS``, the arms' and the lower legs' tapes (``LIMB_SECTIONS``: wrist,
+#: bicep, forearm, calf, ankle, two each) and the shoulder breadth "P".
 PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
                  "G.L": ("front",), "G.R": ("front",), "H.L": ("front",), "H.R": ("front",),
-                 "I.L": ("front",), "I.R": ("front",), "P": ("front",)}
+                 "I.L": ("front",), "I.R": ("front",), "P": ("front",),
+                 "M.L": ("front",), "M.R": ("front",), "N.L": ("front",), "N.R": ("front",)}
 #: The measurements (MEASUREMENTS keys) the photos scale: a tape key's part before its
 #: ".L"/".R".
 SCALED = tuple(dict.fromkeys(tape.split(".")[0] for tape in PHOTO_EXTENTS))
@@ -99,7 +103,9 @@ _OWN_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
               ("F", "front"): ("hip", "leg"), ("P", "front"): ("arm",),
               ("H.L", "front"): ("arm",), ("H.R", "front"): ("arm",),
               ("I.L", "front"): ("arm", "elbow"), ("I.R", "front"): ("arm", "elbow"),
-              ("G.L", "front"): ("elbow", "hand"), ("G.R", "front"): ("elbow", "hand")}
+              ("G.L", "front"): ("elbow", "hand"), ("G.R", "front"): ("elbow", "hand"),
+              ("M.L", "front"): ("leg",), ("M.R", "front"): ("leg",),
+              ("N.L", "front"): ("leg", "foot"), ("N.R", "front"): ("leg", "foot")}
 #: tape key -> the rows above and below its centre row whose widths are averaged
 #: (_OTHER_BAND elsewhere): the neck's and the shoulder breadth's features are short (chin
 #: and shoulders, the deltoids' rounding).
@@ -174,7 +180,7 @@ def silhouette_axis(measurer: Measurer, body: np.ndarray, key: str, view: str) -
     """(3,) unit, body frame: the direction in girth ``key``'s plane (on ``body`` (V, 3)
     metres) across the ``view``'s line of sight, along which the view's photo shows the
     section's extent: the trunk's and the neck's first section axis (across the body) in
-    the front view, their second (front to back) in the side view; an arm tape's lies
+    the front view, their second (front to back) in the side view; a limb tape's lies
     between, its limb not in the photo's plane (the A-pose's forearm reaches forward)."""
     axis = np.cross(measurer.girth_plane(body, key)[1], _SIGHTS[view])
     return axis / np.linalg.norm(axis)
@@ -190,7 +196,7 @@ def _tape_line(measurer: Measurer, body: np.ndarray, key: str,
     if key == "P":
         return measurer.acromions(body).mean(axis=0) - [0.0, 0.0, SHOULDER_DROP_M], ACROSS
     centre = measurer.girth_centre(body, key)
-    if key in ARM_SECTIONS["G"]:
+    if key in LIMB_SECTIONS["G"]:
         towards_wrist = measurer.girth_plane(body, key)[1]
         centre = centre - WRIST_RISE_M * towards_wrist / np.linalg.norm(towards_wrist)
     return centre, silhouette_axis(measurer, body, key, view)
@@ -318,7 +324,7 @@ def photo_scaled_measurements(model: BodyModel, measurer: Measurer, rest: np.nda
     """key -> mm: the measurements :data:`SCALED` of the fitted body ``rest`` (V, 3)
     metres (rest A-pose, at the person's stature), their tapes of :data:`PHOTO_EXTENTS`
     scaled by their :func:`section_scales`: a girth its section (:func:`scaled_section`;
-    an arm's girth: the mean of its two), the shoulder breadth its length (a tape no ratio
+    a limb's girth: the mean of its two), the shoulder breadth its length (a tape no ratio
     applies to keeps its fitted value)."""
     tapes: dict[str, list[float]] = {}  # measurement -> its tapes' values, mm
     for tape, scale in section_scales(model, measurer, photos).items():

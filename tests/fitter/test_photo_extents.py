@@ -8,7 +8,7 @@ import pytest
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
-from bodyfit.fitter.measurements import ARM_SECTIONS
+from bodyfit.fitter.measurements import LIMB_SECTIONS
 from bodyfit.fitter.photo_extents import (MAX_CHANGE, ViewPhoto, extent_ratio,
                                           outline_width, photo_scaled_measurements, placed_camera,
                                           silhouette_axis, turned_to_tape)
@@ -145,46 +145,48 @@ def test_the_silhouette_axis_lies_in_the_tape_across_the_line_of_sight(measurer,
     assert abs(axis @ measurer.girth_axes(posed, "I.L")[0]) < np.cos(np.radians(10))
 
 
-#: an arm girth -> the regions its tapes widen (each side's) and how far from the tape's
+#: a limb girth -> the regions its tapes widen (each side's) and how far from the tape's
 #: plane the widening is full (metres; it then falls to none over 4 cm more): the
 #: wrist's photo width is read 3 cm up the forearm (``WRIST_RISE_M``), so the person's
 #: whole lower forearm is wider there
-_ARM_REGIONS = {"G": (("forearm", "hand"), 0.05), "H": (("upperarm",), 0.0),
-                "I": (("forearm",), 0.0)}
+_LIMB_REGIONS = {"G": (("forearm", "hand"), 0.05), "H": (("upperarm",), 0.0),
+                 "I": (("forearm",), 0.0), "M": (("shank",), 0.0), "N": (("shank",), 0.0)}
+#: a limb girth -> the least share of the way it must move (``_follows``)
+_LIMB_SHARES = {"G": 0.8, "H": 0.8, "I": 0.6, "M": 0.5, "N": 0.7}
 
 
-def _arms_widened(measurer, vertices: np.ndarray, key: str, factor: float) -> np.ndarray:
-    """``vertices`` (V, 3) with each arm ``factor`` times as wide across girth ``key``'s
+def _limbs_widened(measurer, vertices: np.ndarray, key: str, factor: float) -> np.ndarray:
+    """``vertices`` (V, 3) with each limb ``factor`` times as wide across girth ``key``'s
     tape as the front photo sees it (along its silhouette axis, about the limb's axis
-    through the section's centre), fully near the tape's plane (``_ARM_REGIONS``), less
+    through the section's centre), fully near the tape's plane (``_LIMB_REGIONS``), less
     farther, not at all 4 cm beyond."""
     out = vertices.astype(np.float64).copy()
-    regions, full = _ARM_REGIONS[key]
-    for tape, side in zip(ARM_SECTIONS[key], ("L", "R")):
-        arm = np.concatenate([measurer.landmarks[f"region:{region}.{side}"]
-                              for region in regions])
+    regions, full = _LIMB_REGIONS[key]
+    for tape, side in zip(LIMB_SECTIONS[key], ("L", "R")):
+        limb = np.concatenate([measurer.landmarks[f"region:{region}.{side}"]
+                               for region in regions])
         origin, normal = measurer.girth_plane(out, tape)
         across = silhouette_axis(measurer, out, tape, "front")
         centre = measurer.girth_centre(out, tape)
-        distance = np.abs((out[arm] - origin) @ normal) / np.linalg.norm(normal)
+        distance = np.abs((out[limb] - origin) @ normal) / np.linalg.norm(normal)
         weight = np.clip(1 - (distance - full) / 0.04, 0, 1)
-        offset = (out[arm] - centre) @ across
-        out[arm] += ((factor - 1) * weight * offset)[:, None] * across
+        offset = (out[limb] - centre) @ across
+        out[limb] += ((factor - 1) * weight * offset)[:, None] * across
     return out
 
 
-@pytest.mark.parametrize("key", ["G", "H", "I"])
+@pytest.mark.parametrize("key", ["G", "H", "I", "M", "N"])
 @pytest.mark.parametrize("factor", [1.0, 1.08, 0.93])
-def test_the_arm_girths_follow_the_photo(body_model, measurer, mean_body, key, factor):
-    """Both arms ``factor`` times as wide across the wrist's, the bicep's or the
-    forearm's tapes as the front photo sees them (tilted with the A-pose's arms, some
-    25-45 px across; the forearm reaches forward, out of the photo's plane): the girth
-    moves at least 80 % of the way, the forearm's 60 % (its girth is the largest of 7
-    planes: narrowed at the tape, another plane's is the largest, and the truth moves
-    less than the section)."""
+def test_the_limb_girths_follow_the_photo(body_model, measurer, mean_body, key, factor):
+    """Both limbs ``factor`` times as wide across the wrist's, the bicep's, the forearm's,
+    the calf's or the ankle's tapes as the front photo sees them (tilted
+    with the A-pose's limbs, some 25-45 px across for the arm's; the forearm reaches
+    forward, out of the photo's plane): the girth moves at least 80 % of the way, the
+    forearm's 60 %, the calf's 50 % and the ankle's 70 % (their girth is the largest or
+    the smallest of 6-7 planes: changed at the tape, another plane's may become it, and
+    the truth moves less than the section)."""
     _follows(body_model, measurer, mean_body, key, "front",
-             lambda v, f: _arms_widened(measurer, v, key, f), factor,
-             0.6 if key == "I" else 0.8)
+             lambda v, f: _limbs_widened(measurer, v, key, f), factor, _LIMB_SHARES[key])
 
 
 def test_the_turned_view_is_the_photo_of_a_turned_camera(body_model, measurer, mean_body):
