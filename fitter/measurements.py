@@ -87,9 +87,12 @@ MEASUREMENTS = {
 #: The paper's 7 "visually important" measurements (its Table 4).
 IMPORTANT = ("B", "C", "D", "E", "F", "L", "P")
 
-#: The girths taken on one plane section (the others: the largest of several planes, or
-#: a limb's two sides), and the region each tape keeps to.
-SECTION_GIRTHS = ("B", "D", "E", "F")
+#: The head's, the neck's and the trunk's girths: one plane section each (the head's the
+#: largest of several horizontal planes; the limbs' girths: ``LIMB_SECTIONS``).
+SECTION_GIRTHS = ("A", "B", "D", "E", "F")
+#: Where the head's candidate planes lie, from the neck-top ring's height (0) to the
+#: vertex (1): the largest girth is the tape.
+_HEAD_FRACTIONS = np.linspace(0.5, 0.8, 7)
 #: The limbs' girths (wrist, bicep, forearm, thigh, calf, ankle) -> their two tapes, left
 #: and right (the girth is their mean): plane sections too (:meth:`Measurer.girth_plane`
 #: and the rest take these keys).
@@ -105,7 +108,8 @@ _GIRTH_SPANS = {"I": (np.linspace(0.1, 0.4, 7), np.nanargmax),
                 "N": (np.linspace(0.75, 0.92, 6), np.nanargmin)}
 #: limb tape -> (its girth's key, its side)
 _LIMB_TAPES = {tape: (key, tape[-1]) for key, tapes in LIMB_SECTIONS.items() for tape in tapes}
-_SECTION_REGIONS = {"B": "neck", "D": "trunk", "E": "trunk", "F": "trunk_thighs"} | {
+_SECTION_REGIONS = {"A": "skull", "B": "neck", "D": "trunk", "E": "trunk",
+                    "F": "trunk_thighs"} | {
     tape: f"{_GIRTH_LIMBS[key]}.{side}" for tape, (key, side) in _LIMB_TAPES.items()}
 
 _UP = np.array([0.0, 0.0, 1.0])
@@ -202,13 +206,15 @@ class Measurer:
     def girth_plane(self, vertices: np.ndarray, key: str) -> tuple[np.ndarray, np.ndarray]:
         """(3,) a point of girth ``key``'s plane (one of ``SECTION_GIRTHS`` or a limb tape
         of ``LIMB_SECTIONS``) and (3,) its normal, on ``vertices`` (V, 3) metres, rest
-        A-pose or posed (the trunk and neck do not move with the pose's four angles, a limb
-        tape's plane follows its limb). The neck's: midway between the neck's base and top
-        rings, perpendicular to the line joining them; the trunk's: horizontal; a limb
-        tape's: perpendicular to its limb's axis (the proximal ring's centre to the
-        distal's), for the forearm and the calf at the largest, for the ankle at the
-        smallest of the girths over their spans (``_GIRTH_SPANS``), for the others
-        where :meth:`_limb_fraction` says."""
+        A-pose or posed (the head, neck and trunk do not move with the pose's four angles,
+        a limb tape's plane follows its limb). The head's: horizontal, at the largest of
+        the girths 50-80 % of the way from the neck-top ring up to the vertex
+        (``_HEAD_FRACTIONS``); the neck's: midway between the neck's base and top rings,
+        perpendicular to the line joining them; the trunk's: horizontal; a limb tape's:
+        perpendicular to its limb's axis (the proximal ring's centre to the distal's), for
+        the forearm and the calf at the largest, for the ankle at the smallest of the
+        girths over their spans (``_GIRTH_SPANS``), for the others where
+        :meth:`_limb_fraction` says."""
         v = np.asarray(vertices, np.float64)
         if key in _LIMB_TAPES:
             girth, side = _LIMB_TAPES[key]
@@ -226,7 +232,12 @@ class Measurer:
         if key == "B":
             base, top = self._ring(v, "neck_base"), self._ring(v, "neck_top")
             return 0.5 * (base + top), top - base
-        if key == "D":
+        if key == "A":
+            neck_top = self._ring(v, "neck_top")[2]
+            heights = neck_top + (v[:, 2].max() - neck_top) * _HEAD_FRACTIONS
+            girths = self._horizontal_girth(v, "skull", heights)
+            height = heights[np.nanargmax(girths) if np.isfinite(girths).any() else 0]
+        elif key == "D":
             height = self._point(v, "bust")[:, 2].mean()
         elif key == "E":
             height = self._point(v, "navel")[0, 2]
@@ -286,10 +297,6 @@ class Measurer:
         acromion = self.acromions(v)
         out = {}
 
-        neck_top = self._ring(v, "neck_top")
-        span = top - neck_top[2]
-        out["A"] = np.nanmax(self._horizontal_girth(
-            v, "skull", neck_top[2] + span * np.linspace(0.5, 0.8, 7)))
         for key in SECTION_GIRTHS:
             out[key] = self._plane_girth(v, key)
         out["C"] = acromion[:, 2].mean() - crotch[2]

@@ -10,11 +10,11 @@ compared with the fitted body rendered through the same camera at the photo's re
 the ratio of the person's outline width to the body's, averaged over the lines along the
 tape around its centre, scales the fitted section along that view's silhouette axis
 (:func:`silhouette_axis`, the direction in the tape's plane across the view's line of
-sight: for the trunk and neck the front view's is across the body, the side view's front
-to back), and the tape is the scaled section's convex hull. The wrist's, the bicep's and
-the forearm's two tapes are scaled each by its arm's width across its tape in the front
-photo (the wrist's read :data:`WRIST_RISE_M` up the forearm), the calf's and the ankle's
-by its leg's, the girth their mean. The shoulder breadth (the acromions' distance) is
+sight: for the head, neck and trunk the front view's is across the body, the side
+view's front to back), and the tape is the scaled section's convex hull. The wrist's,
+the bicep's and the forearm's two tapes are scaled each by its arm's width across its
+tape in the front photo (the wrist's read :data:`WRIST_RISE_M` up the forearm), the
+calf's and the ankle's by its leg's, the girth their mean. The shoulder breadth (the acromions' distance) is
 scaled the same way, by the front photo's outline width across the deltoids
 :data:`SHOULDER_DROP_M` below the acromions.
 
@@ -42,7 +42,10 @@ scaled the same way, by the front photo's outline width across the deltoids
   where the body's does not), or where the ratio strays beyond :data:`MAX_CHANGE` (hair
   or clothing, not the body, makes that outline).
 - Which measurements and views: chosen by measured error (docs/accuracy.md steps
-  28-31): the neck's, the chest's, the waist's and the hip's width from the front photo,
+  28-32): the head's width from the front photo and its depth from the side photo (its
+  tape horizontal; hair, which the benchmark's subjects lack, would widen both and the
+  girth with them, within :data:`MAX_CHANGE`), the neck's, the chest's, the waist's and
+  the hip's width from the front photo,
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
   rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits),
@@ -79,12 +82,12 @@ __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "SHOULDER_DROP_M", "WRIST_RI
            "extent_ratio", "section_scales", "scaled_section", "photo_scaled_measurements"]
 
 #: tape key -> the views whose photo sets its extent (along the view's
-#: :func:`silhouette_axis`: for the trunk and neck "front" is across the body, "side"
+#: :func:`silhouette_axis`: for the head, neck and trunk "front" is across the body, "side"
 #: front to back): the girths of
 #: ``SECTION_GIRTHS``, the arms' and the lower legs' tapes (``LIMB_SECTIONS``: wrist,
 #: bicep, forearm, calf, ankle, two each) and the shoulder breadth "P".
-PHOTO_EXTENTS = {"B": ("front", "side"), "D": ("front",), "E": ("front",), "F": ("front",),
-                 "G.L": ("front",), "G.R": ("front",), "H.L": ("front",), "H.R": ("front",),
+PHOTO_EXTENTS = {"A": ("front", "side"), "B": ("front", "side"), "D": ("front",),
+                 "E": ("front",), "F": ("front",), "G.L": ("front",), "G.R": ("front",), "H.L": ("front",), "H.R": ("front",),
                  "I.L": ("front",), "I.R": ("front",), "P": ("front",),
                  "M.L": ("front",), "M.R": ("front",), "N.L": ("front",), "N.R": ("front",)}
 #: The measurements (MEASUREMENTS keys) the photos scale: a tape key's part before its
@@ -98,7 +101,8 @@ SHOULDER_DROP_M = 0.02
 #: the thumb's base crosses; the ratio there scales the wrist's section.
 WRIST_RISE_M = 0.03
 #: (key, view) -> its own parts: the rendered outline at the tape's rows must be of these.
-_OWN_PARTS = {("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
+_OWN_PARTS = {("A", "front"): ("head",), ("A", "side"): ("head",),
+              ("B", "front"): ("neck",), ("B", "side"): ("neck", "head"),
               ("D", "front"): ("chest",), ("E", "front"): ("waist",),
               ("F", "front"): ("hip", "leg"), ("P", "front"): ("arm",),
               ("H.L", "front"): ("arm",), ("H.R", "front"): ("arm",),
@@ -179,9 +183,10 @@ def placed_camera(model: BodyModel, photo: ViewPhoto) -> tuple[np.ndarray, np.nd
 def silhouette_axis(measurer: Measurer, body: np.ndarray, key: str, view: str) -> np.ndarray:
     """(3,) unit, body frame: the direction in girth ``key``'s plane (on ``body`` (V, 3)
     metres) across the ``view``'s line of sight, along which the view's photo shows the
-    section's extent: the trunk's and the neck's first section axis (across the body) in
-    the front view, their second (front to back) in the side view; a limb tape's lies
-    between, its limb not in the photo's plane (the A-pose's forearm reaches forward)."""
+    section's extent: the head's, the neck's and the trunk's first section axis (across
+    the body) in the front view, their second (front to back) in the side view; a limb
+    tape's lies between, its limb not in the photo's plane (the A-pose's forearm reaches
+    forward)."""
     axis = np.cross(measurer.girth_plane(body, key)[1], _SIGHTS[view])
     return axis / np.linalg.norm(axis)
 

@@ -49,6 +49,18 @@ def _neck_deepened(measurer, vertices: np.ndarray, factor: float) -> np.ndarray:
     return out
 
 
+def _head_scaled(measurer, vertices: np.ndarray, factor: float, axis: int) -> np.ndarray:
+    """``vertices`` (V, 3) with the head ``factor`` times as wide (``axis`` 0) or as deep
+    (1) about its tape's centre: fully from 3 cm above the neck-top ring up, not at all
+    below the ring, evenly between."""
+    out = vertices.astype(np.float64).copy()
+    neck_top = out[measurer.landmarks["ring:neck_top"], 2].mean()
+    weight = np.clip((out[:, 2] - neck_top) / 0.03, 0, 1)
+    centre = measurer.girth_centre(out, "A")[axis]
+    out[:, axis] = centre + (1 + (factor - 1) * weight) * (out[:, axis] - centre)
+    return out
+
+
 def _labels(body_model, body: np.ndarray, k: np.ndarray, camera) -> np.ndarray:
     """(H, W) int8 part labels of ``body`` (V, 3) through K ``k`` and (R, t) ``camera``."""
     return kernels.rasterize(body[None].astype(np.float32), body_model.faces,
@@ -106,6 +118,16 @@ def test_the_neck_girth_follows_the_side_photo(body_model, measurer, mean_body, 
     band's rows either side of the tape see less of the deepening)."""
     _follows(body_model, measurer, mean_body, "B", "side",
              lambda v, f: _neck_deepened(measurer, v, f), factor, 2 / 3)
+
+
+@pytest.mark.parametrize("view", ["front", "side"])
+@pytest.mark.parametrize("factor", [1.0, 1.06, 0.95])
+def test_the_head_girth_follows_the_photo(body_model, measurer, mean_body, view, factor):
+    """The head ``factor`` times as wide, seen from the front, or as deep, seen from the
+    side: the girth moves at least 80 % of the way."""
+    _follows(body_model, measurer, mean_body, "A", view,
+             lambda v, f: _head_scaled(measurer, v, f, 0 if view == "front" else 1), factor,
+             0.8)
 
 
 def _shoulders_widened(measurer, vertices: np.ndarray, factor: float) -> np.ndarray:
