@@ -1,8 +1,8 @@
-"""A lighter mesh for scoring candidates: head, hands and feet clustered, the rest as it is.
+"""A lighter mesh for scoring candidates: head and feet clustered, the rest as it is.
 
-Head, hands and feet hold 72 % of the model's triangles (19,232 of 26,692), mostly smaller
-than a canvas pixel (4-5 mm), and every triangle costs the rasteriser a setup whether it
-covers a pixel centre or not. :func:`render_model` merges those parts' vertices that fall
+Head and feet hold 47 % of the model's triangles (12,414 of 26,692), mostly smaller than a
+canvas pixel (4-5 mm), and every triangle costs the rasteriser a setup whether it covers a
+pixel centre or not. :func:`render_model` merges those parts' vertices that fall
 in one cube of ``cell_mm`` (per part, in the mean body's rest shape; each cluster keeps
 its member nearest the cluster's centroid, so the kept vertices are the model's own and
 skin exactly as before) and drops the triangles that collapse. Kept as they are: every
@@ -12,10 +12,12 @@ the height the stature conditioning solved for).
 
 The model it returns is a :class:`~bodyfit.fitter.body_model.BodyModel` over the kept
 vertices (no landmarks): the kernels render and score it; the fitted body, its
-measurements and the pictures use the full model. At 8 mm: 15,846 triangles, 7,836
-vertices; the kernels 1.2x faster; silhouettes of random candidates differ from the full
-mesh's by about 40 of 30,000 pixels at 400 px (fingers and ears), costs by 0.06 %
-(median); the fits' error: docs/fitter.md, "Speed".
+measurements and the pictures use the full model. At 8 mm: 19,900 triangles, 9,874
+vertices; the kernels' speed: docs/fitter.md, "Speed".
+
+The hands (6,380 triangles) were clustered too until docs/accuracy.md's step 34: a hand
+of 8 mm cubes reaches about 1 mm less far than the model's, which the fits paid for with
+longer arms (the arm length's error in-space 3.10 -> 2.59 mm with the hands left whole).
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from bodyfit.fitter.body_model import PART_NAMES, BodyModel
 __all__ = ["CLUSTERED_PARTS", "render_model"]
 
 #: The parts whose vertices are clustered.
-CLUSTERED_PARTS = ("head", "hand", "foot")
+CLUSTERED_PARTS = ("head", "foot")
 #: Vertices this close (metres) to the mean body's highest or lowest point are kept.
 _EXTREME_BAND_M = 0.01
 

@@ -2,11 +2,14 @@
 
     python tools/bench_kernels.py                      # CPU, P = 30, 256, 1024, 512 px
     python tools/bench_kernels.py --device cuda:0 --populations 30 256 1024 4096 16384
+    python tools/bench_kernels.py --populations 30 --render-cell-mm 8   # the fitter's mesh
 
 A synthetic person (a body of the model) is photographed front and side by the
 orthographic paper cameras at the given image height; populations are drawn like the
 GA's first generation (betas uniform in +-3 sigma, angles in 0-30 degrees) and, for the
 total only, like a late generation (within 0.3 sigma and 3 degrees of the person). The
+candidates are the full model's, or with ``--render-cell-mm`` the lighter mesh the fitter
+renders (bodyfit.fitter.render_mesh; the person's photos stay the full model's). The
 same run times the NumPy/OpenCV reference pipeline (bodyfit.kernels.reference) on a few
 candidates of the first population and checks the nearest-boundary distances against
 scipy.ndimage.distance_transform_edt. Prints Markdown (docs/kernels.md holds the output).
@@ -27,6 +30,7 @@ import warp as wp
 
 from bodyfit.fitter.body_model import PART_NAMES, forward
 from bodyfit.fitter.model_cache import load_model
+from bodyfit.fitter.render_mesh import render_model
 from bodyfit.kernels.boundary import nearest_boundary
 from bodyfit.kernels.view_camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 from bodyfit.kernels.cost import CostSettings
@@ -105,13 +109,17 @@ def main() -> None:
     parser.add_argument("--reference-candidates", type=int, default=6,
                         help="candidates timed through the NumPy/OpenCV reference")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--render-cell-mm", type=float, default=0.0,
+                        help="candidates on the fitter's render mesh at this cell size "
+                             "(FitSettings.render_cell_mm; 0: the full model)")
     args = parser.parse_args()
 
     wp.config.log_level = wp.LOG_WARNING  # keep Warp's start-up and module lines out
     model = load_model()
-    try:  # the kernels raise ValueError, with a message for the user, for a bad device
+    try:  # ValueError, with a message for the user: a bad device or cell size
         device = resolve_device(args.device)
-        arrays = ModelArrays.from_body_model(model, 20, device)
+        rendered = render_model(model, args.render_cell_mm)
+        arrays = ModelArrays.from_body_model(rendered, 20, device)
     except ValueError as exc:
         sys.exit(f"bench_kernels: error: {exc}")
     views, person = _views(model, args.height, device, args.seed)
@@ -126,9 +134,10 @@ def main() -> None:
     print(f"Canvas {args.height} px high: front {views[0].width} px wide "
           f"({views[0].boundary_points.shape[0]} person boundary points), side "
           f"{views[1].width} px ({views[1].boundary_points.shape[0]}); "
-          f"{model.faces.shape[0]} triangles front, "
-          f"{len(visible_faces(model.faces, model.face_parts, SIDE_VIEW_PARTS)[0])} "
-          f"side; {model.num_vertices} vertices; matching {settings.matching}.\n")
+          f"candidates: {rendered.faces.shape[0]} triangles front, "
+          f"{len(visible_faces(rendered.faces, rendered.face_parts, SIDE_VIEW_PARTS)[0])} "
+          f"side, {rendered.num_vertices} vertices (render cell {args.render_cell_mm:g} mm); "
+          f"matching {settings.matching}.\n")
     header = "| P | " + " | ".join(f"{s} (cv/s)" for s in STAGES)
     print(header + " | total (cv/s) | ms per cv | late generation (cv/s) | buffers (MB) | peak RSS (MB) |")
     print("|" + "---|" * (len(STAGES) + 6))
@@ -162,7 +171,7 @@ def main() -> None:
 
     sample = _populations(args.reference_candidates, person, args.seed)[0]
     start = clock()
-    reference_costs, _ = population_cost(model, *sample, views, settings)
+    reference_costs, _ = population_cost(rendered, *sample, views, settings)
     reference_s = (clock() - start) / (args.reference_candidates * num_views)
     kernel_costs = PopulationEvaluator(arrays, views, settings).evaluate(*sample).costs
     agreement = np.median(np.abs(kernel_costs - reference_costs) / reference_costs)
@@ -174,7 +183,7 @@ def main() -> None:
           f"{'met' if ratio >= REFERENCE_TARGET_RATIO else 'missed'}). Median cost difference "
           f"{100 * agreement:.1f} % (the reference's cv2.fillPoly dilates silhouettes by about "
           "half a pixel).\n")
-    mean_error, max_error = _distance_errors(model, views, (sample[0][:2], sample[1][:2]))
+    mean_error, max_error = _distance_errors(rendered, views, (sample[0][:2], sample[1][:2]))
     print(f"Nearest boundary pixel vs scipy.ndimage.distance_transform_edt, every pixel of "
           f"2 front maps: mean error {mean_error:.2e} px, max {max_error:.2e} px.\n")
     if device.is_cuda:

@@ -16,7 +16,7 @@ def light(body_model):
     return render_model(body_model, 8.0)
 
 
-def test_only_head_hands_and_feet_lose_triangles(body_model, light):
+def test_only_head_and_feet_lose_triangles(body_model, light):
     full = np.bincount(body_model.face_parts, minlength=len(PART_NAMES))
     kept = np.bincount(light.face_parts, minlength=len(PART_NAMES))
     for part, name in enumerate(PART_NAMES):
@@ -43,8 +43,9 @@ def test_vertices_are_the_models_own_and_skin_alike(body_model, light):
 
 
 def test_silhouettes_match_the_full_mesh(body_model, light):
-    """Front and side at 400 px for random bodies: at most 0.3 % of the silhouette's pixels
-    differ (fingers, ears); the full mesh itself differs by 0."""
+    """Front and side at 400 px for random bodies: at most 0.1 % of the silhouette's pixels
+    differ (ears, toes: 0.04 %; with the hands clustered too the side view's differed by
+    0.23 %); the full mesh itself differs by 0."""
     rng = np.random.default_rng(5)
     betas, pose = np.clip(rng.normal(size=(4, 20)), -2, 2), rng.uniform(-5, 25, (4, 4))
     posed = forward(body_model, betas, pose)
@@ -61,4 +62,4 @@ def test_silhouettes_match_the_full_mesh(body_model, light):
         full, mine = maps
         assert full.sum(axis=(1, 2)).min() > 10000
         assert not full[:, [0, -1]].any() and not full[:, :, [0, -1]].any()  # in frame
-        assert (full ^ mine).sum() <= 0.003 * full.sum()
+        assert (full ^ mine).sum() <= 0.001 * full.sum()
