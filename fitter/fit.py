@@ -47,8 +47,9 @@ class FitSettings:
         device: where the kernels run, "cpu" or "cuda:0".
         threads: CPU threads evaluating each population side by side (None: one per core
             this process may use; ignored on a GPU). The result does not depend on it.
-        render_cell_mm: the candidates are rendered with head and feet clustered
-            to cubes of this size (:mod:`bodyfit.fitter.render_mesh`; 0: the full mesh).
+        render_cell_mm: the candidates are rendered with the parts of
+            ``render_mesh.CLUSTERED_PARTS`` clustered to cubes of this size
+            (:mod:`bodyfit.fitter.render_mesh`; 0: the full mesh).
         side_arms: how the side view treats the person's arms, one of
             ``bodyfit.fitter.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
             arms hanging down; "hidden": without arms).
