@@ -30,7 +30,12 @@ subtraction and shadow detection", 1999):
    first outline 2-3 px outside the edge, so one pass still takes the local person
    colour partly from mixed pixels; on the accuracy benchmark's JPEG photos it left the
    outline 0.24 px outside the exact one on average, four passes leave 0.05 px
-   (docs/accuracy.md, "Pushing the numbers").
+   (docs/accuracy.md, "Pushing the numbers"). Where no backdrop pixel lies in a pixel's
+   window (a gap between fingers, which the low threshold and the closing fill), the
+   modelled backdrop colour of step 1 stands for the local one, and each pass carves
+   ``outline_band_px`` further into such a gap: eight passes reopen the gaps between
+   the fingers that four left filled, which made the hands look larger and the fitted
+   arms longer (docs/accuracy.md, step 35).
 5. Enclosed holes smaller than ``max_hole_fraction`` of the person are filled (larger
    ones are real gaps, e.g. between an arm and the body with a hand on the hip).
 
@@ -108,7 +113,7 @@ class SilhouetteSettings:
     max_second_region_ratio: float = 0.15
     outline_band_px: int = 2
     outline_window_px: int = 11
-    outline_passes: int = 4
+    outline_passes: int = 8
     max_hole_fraction: float = 0.01
 
     def __post_init__(self) -> None:
@@ -219,14 +224,18 @@ def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray
     return labels == largest + 1
 
 
-def _refine_outline(image: np.ndarray, region: np.ndarray, settings: SilhouetteSettings) -> np.ndarray:
+def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
+                    settings: SilhouetteSettings) -> np.ndarray:
     """Move the outline to where edge pixels are half person, half backdrop.
 
     Near the outline a pixel's colour I mixes the person's local colour P and the
     backdrop's local colour B (each the mean of the confidently inside or outside pixels
-    in a ``outline_window_px`` window, so a shadow next to the person is part of B). The
-    pixel is person when its mixing fraction ``(I - B).(P - B) / |P - B|^2`` is at least
-    one half. Returns the largest region of the result.
+    in a ``outline_window_px`` window, so a shadow next to the person is part of B). In
+    a gap too narrow to hold a confidently outside pixel (between fingers, where the
+    first threshold joins both fingers' blurred edges) B is the modelled ``backdrop``
+    (H, W, 3) float32 there. The pixel is person when its mixing fraction
+    ``(I - B).(P - B) / |P - B|^2`` is at least one half. Returns the largest region of
+    the result.
     """
     pixels = image.astype(np.float32)
     marked = region.astype(np.uint8)
@@ -242,11 +251,12 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, settings: SilhouetteS
 
     person_colour, person_weight = local_mean(inside)
     backdrop_colour, backdrop_weight = local_mean(outside)
+    backdrop_colour[backdrop_weight == 0] = backdrop[backdrop_weight == 0]
     contrast = person_colour - backdrop_colour
     fraction = np.einsum("hwc,hwc->hw", pixels - backdrop_colour, contrast) / np.maximum(
         np.einsum("hwc,hwc->hw", contrast, contrast), 1e-6
     )
-    band = ~inside & ~outside & (person_weight > 0) & (backdrop_weight > 0)
+    band = ~inside & ~outside & (person_weight > 0)
     refined = region.copy()
     refined[band] = fraction[band] >= 0.5
     labels, stats = _components(refined)
@@ -343,7 +353,7 @@ def extract_silhouette(
         )
     region = _person_region(_clean(foreground, settings), settings)
     for _ in range(settings.outline_passes):
-        region = _refine_outline(image_bgr, region, settings)
+        region = _refine_outline(image_bgr, region, backdrop, settings)
     return _fill_small_holes(region, settings)
 
 
