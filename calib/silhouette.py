@@ -31,7 +31,7 @@ subtraction and shadow detection", 1999):
    colour partly from mixed pixels; on the accuracy benchmark's JPEG photos it left the
    outline 0.24 px outside the exact one on average, four passes leave 0.05 px
    (docs/accuracy.md, "Pushing the numbers"). Where no backdrop pixel lies in a pixel's
-   window (a gap between fingers, which the low threshold and the closing fill), the
+   window (a gap between fingers, which the low threshold fills), the
    modelled backdrop colour of step 1 stands for the local one, and each pass carves
    ``outline_band_px`` further into such a gap: eight passes reopen the gaps between
    the fingers that four left filled, which made the hands look larger and the fitted
