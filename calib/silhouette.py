@@ -251,7 +251,8 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
 
     person_colour, person_weight = local_mean(inside)
     backdrop_colour, backdrop_weight = local_mean(outside)
-    backdrop_colour[backdrop_weight == 0] = backdrop[backdrop_weight == 0]
+    no_backdrop_near = backdrop_weight == 0
+    backdrop_colour[no_backdrop_near] = backdrop[no_backdrop_near]
     contrast = person_colour - backdrop_colour
     fraction = np.einsum("hwc,hwc->hw", pixels - backdrop_colour, contrast) / np.maximum(
         np.einsum("hwc,hwc->hw", contrast, contrast), 1e-6

@@ -45,6 +45,13 @@ def test_a_soft_photo_keeps_its_outline_where_edges_are_half_way(studio):
     assert iou(unrefined, truth) < 0.98
 
 
+def _jpeg(photo: np.ndarray) -> np.ndarray:
+    """(H, W, 3) uint8 BGR ``photo`` as a phone stores it: a JPEG of quality 90, decoded."""
+    ok, data = cv2.imencode(".jpg", photo, [cv2.IMWRITE_JPEG_QUALITY, 90])
+    assert ok
+    return cv2.imdecode(data, cv2.IMREAD_COLOR)
+
+
 def _outward_px(mask: np.ndarray, truth: np.ndarray) -> float:
     """How far ``mask``'s outline lies outside ``truth``'s, pixels, on average."""
     contours, _ = cv2.findContours(truth.astype(np.uint8), cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
@@ -55,9 +62,7 @@ def test_a_jpeg_photo_keeps_its_outline_on_the_edge(studio):
     # JPEG's ringing lets the first outline land 2-3 px outside the edge; one refinement
     # pass then leaves it about half a pixel out, repeated passes bring it onto the edge.
     photo, truth = studio
-    ok, data = cv2.imencode(".jpg", cv2.GaussianBlur(photo, (0, 0), 1.2), [cv2.IMWRITE_JPEG_QUALITY, 90])
-    assert ok
-    jpeg = cv2.imdecode(data, cv2.IMREAD_COLOR)
+    jpeg = _jpeg(cv2.GaussianBlur(photo, (0, 0), 1.2))
     assert abs(_outward_px(extract_silhouette(jpeg), truth)) < 0.05
     assert _outward_px(extract_silhouette(jpeg, settings=SilhouetteSettings(outline_passes=1)), truth) > 0.4
 
@@ -97,10 +102,7 @@ def test_the_gaps_between_fingers_stay_open():
     photo = (1.0 - coverage[..., None]) * np.asarray(BACKDROP, np.float32) \
         + coverage[..., None] * np.asarray(SKIN, np.float32)
     photo += np.random.default_rng(0).normal(0.0, 3.0, photo.shape)
-    ok, data = cv2.imencode(".jpg", np.clip(np.rint(photo), 0, 255).astype(np.uint8),
-                            [cv2.IMWRITE_JPEG_QUALITY, 90])
-    assert ok
-    jpeg = cv2.imdecode(data, cv2.IMREAD_COLOR)
+    jpeg = _jpeg(np.clip(np.rint(photo), 0, 255).astype(np.uint8))
     gaps = hull & (coverage < 0.2)  # clearly backdrop, between the fingers
     filled = int((extract_silhouette(jpeg) & gaps).sum())
     assert filled < 0.15 * gaps.sum()
