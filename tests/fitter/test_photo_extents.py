@@ -242,6 +242,34 @@ def test_a_change_beyond_the_bound_keeps_the_fitted_girth(body_model, measurer, 
     assert got == pytest.approx(measurer.measure(rest)["B"], abs=1e-6)
 
 
+def _neck_flared(measurer, vertices: np.ndarray, slope: float) -> np.ndarray:
+    """``vertices`` (V, 3) with the neck region's x scaled about its centre by
+    ``1 + slope (z - z_tape)`` (``slope`` per metre of height from the neck tape's centre):
+    an outline that widens upwards where the body's does not (the jaw's underside)."""
+    out = vertices.astype(np.float64).copy()
+    neck = measurer.landmarks["region:neck"]
+    centre = out[neck, 0].mean()
+    factor = 1 + slope * (out[neck, 2] - measurer.girth_centre(out, "B")[2])
+    out[neck, 0] = centre + factor * (out[neck, 0] - centre)
+    return out
+
+
+def test_a_neck_outline_widening_across_its_band_keeps_the_fitted_neck(body_model, measurer,
+                                                                       mean_body):
+    """A person whose neck widens by 2.5 % per mm of height (some 20 % over the band's 5
+    rows of 2 mm, its mean ratio still about 1) gives no neck ratio; widened evenly by 8 %,
+    the same neck gives one of 1.08."""
+    posed, _ = mean_body
+    ratios = {}
+    for name, body in (("flared", _neck_flared(measurer, posed, 25.0)),
+                       ("even", _neck_widened(body_model, measurer, posed, 1.08))):
+        photo = ViewPhoto("front", _photo_of(body_model, body), K, posed, PART_NAMES)
+        ratios[name] = extent_ratio(body_model, measurer, "B", photo,
+                                    placed_camera(body_model, photo))
+    assert ratios["flared"] is None
+    assert ratios["even"] == pytest.approx(1.08, abs=0.02)
+
+
 def test_a_person_whose_arms_touch_the_chest_keeps_the_fitted_chest(body_model, measurer,
                                                                     mean_body):
     """The fitted body's arms hang clear of its chest; a person whose outline joins arm and
