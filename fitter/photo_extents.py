@@ -83,9 +83,10 @@ from bodyfit.fitter.pinhole_canvas import solve_placement
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "MAX_ROW_SPREAD", "SHOULDER_DROP_M", "WRIST_RISE_M",
-           "ViewPhoto", "outline_width", "placed_camera", "silhouette_axis", "turned_to_tape",
-           "extent_ratio", "section_scales", "scaled_section", "photo_scaled_measurements"]
+__all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "MAX_ROW_SPREAD", "SHOULDER_DROP_M",
+           "WRIST_RISE_M", "ViewPhoto", "outline_width", "placed_camera", "silhouette_axis",
+           "turned_to_tape", "extent_ratio", "section_scales", "scaled_section",
+           "photo_scaled_measurements"]
 
 #: tape key -> the views whose photo sets its extent (along the view's
 #: :func:`silhouette_axis`: for the head, neck and trunk "front" is across the body, "side"

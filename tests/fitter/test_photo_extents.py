@@ -28,12 +28,16 @@ def test_outline_width_takes_the_run_at_or_nearest_the_column():
     assert outline_width(np.zeros(5, bool), 2.0) == (0, -1)
 
 
-def _neck_widened(body_model, measurer, vertices: np.ndarray, factor: float) -> np.ndarray:
-    """``vertices`` (V, 3) with the neck region's x scaled by ``factor`` about its centre."""
+def _neck_widened(body_model, measurer, vertices: np.ndarray, factor: float,
+                  slope: float = 0.0) -> np.ndarray:
+    """``vertices`` (V, 3) with the neck region's x scaled about its centre by ``factor``
+    plus ``slope`` per metre of height above the neck tape's centre (a slope makes an
+    outline that widens upwards where the body's does not, as the jaw's underside does)."""
     out = vertices.astype(np.float64).copy()
     neck = measurer.landmarks["region:neck"]
     centre = out[neck, 0].mean()
-    out[neck, 0] = centre + factor * (out[neck, 0] - centre)
+    scale = factor + slope * (out[neck, 2] - measurer.girth_centre(out, "B")[2])
+    out[neck, 0] = centre + scale * (out[neck, 0] - centre)
     return out
 
 
@@ -242,18 +246,6 @@ def test_a_change_beyond_the_bound_keeps_the_fitted_girth(body_model, measurer, 
     assert got == pytest.approx(measurer.measure(rest)["B"], abs=1e-6)
 
 
-def _neck_flared(measurer, vertices: np.ndarray, slope: float) -> np.ndarray:
-    """``vertices`` (V, 3) with the neck region's x scaled about its centre by
-    ``1 + slope (z - z_tape)`` (``slope`` per metre of height from the neck tape's centre):
-    an outline that widens upwards where the body's does not (the jaw's underside)."""
-    out = vertices.astype(np.float64).copy()
-    neck = measurer.landmarks["region:neck"]
-    centre = out[neck, 0].mean()
-    factor = 1 + slope * (out[neck, 2] - measurer.girth_centre(out, "B")[2])
-    out[neck, 0] = centre + factor * (out[neck, 0] - centre)
-    return out
-
-
 def test_a_neck_outline_widening_across_its_band_keeps_the_fitted_neck(body_model, measurer,
                                                                        mean_body):
     """A person whose neck widens by 2.5 % per mm of height (some 20 % over the band's 5
@@ -261,7 +253,7 @@ def test_a_neck_outline_widening_across_its_band_keeps_the_fitted_neck(body_mode
     the same neck gives one of 1.08."""
     posed, _ = mean_body
     ratios = {}
-    for name, body in (("flared", _neck_flared(measurer, posed, 25.0)),
+    for name, body in (("flared", _neck_widened(body_model, measurer, posed, 1.0, slope=25.0)),
                        ("even", _neck_widened(body_model, measurer, posed, 1.08))):
         photo = ViewPhoto("front", _photo_of(body_model, body), K, posed, PART_NAMES)
         ratios[name] = extent_ratio(body_model, measurer, "B", photo,
