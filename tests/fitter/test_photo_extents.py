@@ -8,6 +8,7 @@ import pytest
 
 from bodyfit import kernels
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
+from bodyfit.fitter import photo_extents
 from bodyfit.fitter.measurements import LIMB_SECTIONS
 from bodyfit.fitter.photo_extents import (MAX_CHANGE, ViewPhoto, extent_ratio,
                                           outline_width, photo_scaled_measurements, placed_camera,
@@ -260,6 +261,24 @@ def test_a_neck_outline_widening_across_its_band_keeps_the_fitted_neck(body_mode
                                     placed_camera(body_model, photo))
     assert ratios["flared"] is None
     assert ratios["even"] == pytest.approx(1.08, abs=0.02)
+
+
+def test_a_neck_band_on_a_slope_keeps_the_fitted_neck(body_model, measurer, mean_body,
+                                                    monkeypatch):
+    """A fitted body whose neck narrows by 2.5 % per mm of height at its tape (its
+    outline's sides some 54 degrees from upright over the band), photographed 8 % wider
+    all over: no neck ratio; with the lean guard off, one of 1.10 (on the slope a row's
+    width reads more than the 8 %)."""
+    posed, _ = mean_body
+    sloped = _neck_widened(body_model, measurer, posed, 1.0, slope=-25.0)
+    photo = ViewPhoto("front", _photo_of(body_model, _neck_widened(body_model, measurer,
+                                                                   sloped, 1.08)),
+                      K, sloped, PART_NAMES)
+    assert extent_ratio(body_model, measurer, "B", photo,
+                        placed_camera(body_model, photo)) is None
+    monkeypatch.setattr(photo_extents, "MAX_OUTLINE_LEAN_DEG", {})
+    assert extent_ratio(body_model, measurer, "B", photo,
+                        placed_camera(body_model, photo)) == pytest.approx(1.10, abs=0.02)
 
 
 def test_a_person_whose_arms_touch_the_chest_keeps_the_fitted_chest(body_model, measurer,
