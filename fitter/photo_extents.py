@@ -90,9 +90,9 @@ from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "MAX_ROW_SPREAD", "MAX_OUTLINE_LEAN_DEG",
-           "SHOULDER_DROP_M", "WRIST_RISE_M", "ViewPhoto", "outline_width", "placed_camera", "silhouette_axis",
-           "turned_to_tape", "extent_ratio", "section_scales", "scaled_section",
-           "photo_scaled_measurements"]
+           "SHOULDER_DROP_M", "WRIST_RISE_M", "ViewPhoto", "outline_width", "placed_camera",
+           "silhouette_axis", "turned_to_tape", "extent_ratio", "section_scales",
+           "scaled_section", "photo_scaled_measurements"]
 
 #: tape key -> the views whose photo sets its extent (along the view's
 #: :func:`silhouette_axis`: for the head, neck and trunk "front" is across the body, "side"

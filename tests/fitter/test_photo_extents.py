@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from bodyfit import kernels
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
 from bodyfit.fitter import photo_extents
+from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import LIMB_SECTIONS
 from bodyfit.fitter.photo_extents import (MAX_CHANGE, ViewPhoto, extent_ratio,
                                           outline_width, photo_scaled_measurements, placed_camera,
@@ -266,7 +266,7 @@ def test_a_neck_outline_widening_across_its_band_keeps_the_fitted_neck(body_mode
 def test_a_neck_band_on_a_slope_keeps_the_fitted_neck(body_model, measurer, mean_body,
                                                     monkeypatch):
     """A fitted body whose neck narrows by 2.5 % per mm of height at its tape (its
-    outline's sides some 54 degrees from upright over the band), photographed 8 % wider
+    outline's sides over 45 degrees from upright across the band), photographed 8 % wider
     all over: no neck ratio; with the lean guard off, one of 1.10 (on the slope a row's
     width reads more than the 8 %)."""
     posed, _ = mean_body
