@@ -32,8 +32,9 @@ def test_outline_width_takes_the_run_at_or_nearest_the_column():
 def _neck_widened(body_model, measurer, vertices: np.ndarray, factor: float,
                   slope: float = 0.0) -> np.ndarray:
     """``vertices`` (V, 3) with the neck region's x scaled about its centre by ``factor``
-    plus ``slope`` per metre of height above the neck tape's centre (a slope makes an
-    outline that widens upwards where the body's does not, as the jaw's underside does)."""
+    plus ``slope`` per metre of height above the neck tape's centre (a positive slope
+    widens the outline upwards, as the jaw's underside does; a negative one flares it
+    downwards, as the neck's base into the shoulders does)."""
     out = vertices.astype(np.float64).copy()
     neck = measurer.landmarks["region:neck"]
     centre = out[neck, 0].mean()
@@ -274,11 +275,10 @@ def test_a_neck_band_on_a_slope_keeps_the_fitted_neck(body_model, measurer, mean
     photo = ViewPhoto("front", _photo_of(body_model, _neck_widened(body_model, measurer,
                                                                    sloped, 1.08)),
                       K, sloped, PART_NAMES)
-    assert extent_ratio(body_model, measurer, "B", photo,
-                        placed_camera(body_model, photo)) is None
+    camera = placed_camera(body_model, photo)
+    assert extent_ratio(body_model, measurer, "B", photo, camera) is None
     monkeypatch.setattr(photo_extents, "MAX_OUTLINE_LEAN_DEG", {})
-    assert extent_ratio(body_model, measurer, "B", photo,
-                        placed_camera(body_model, photo)) == pytest.approx(1.10, abs=0.02)
+    assert extent_ratio(body_model, measurer, "B", photo, camera) == pytest.approx(1.10, abs=0.02)
 
 
 def test_a_person_whose_arms_touch_the_chest_keeps_the_fitted_chest(body_model, measurer,
