@@ -224,6 +224,16 @@ def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray
     return labels == largest + 1
 
 
+def _mixing_fraction(pixels: np.ndarray, person: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
+    """(H, W) float32: how much of the person's colour each pixel holds,
+    ``(I - B).(P - B) / |P - B|^2``, for (H, W, 3) float32 ``pixels`` I, ``person`` P and
+    ``backdrop`` B colours."""
+    contrast = person - backdrop
+    return np.einsum("hwc,hwc->hw", pixels - backdrop, contrast) / np.maximum(
+        np.einsum("hwc,hwc->hw", contrast, contrast), 1e-6
+    )
+
+
 def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
                     settings: SilhouetteSettings) -> np.ndarray:
     """Move the outline to where edge pixels are half person, half backdrop.
@@ -234,14 +244,21 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     a gap too narrow to hold a confidently outside pixel (between fingers, where the
     first threshold joins both fingers' blurred edges) B is the modelled ``backdrop``
     (H, W, 3) float32 there. The pixel is person when its mixing fraction
-    ``(I - B).(P - B) / |P - B|^2`` is at least one half. Returns the largest region of
-    the result.
+    ``(I - B).(P - B) / |P - B|^2`` is at least one half, with P the window's inside
+    colour and again with P the mean of the window's pixels two pixels inside the
+    outline (where there are any): a limb turns away from the camera at its outline, and
+    shaded darker there than further in it made edge pixels look more person than they
+    are; a blurred edge makes the nearer colour partly backdrop instead, and the window's
+    decides. Returns the largest region of the result.
     """
     pixels = image.astype(np.float32)
     marked = region.astype(np.uint8)
     shrink = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * settings.outline_band_px + 1,) * 2)
     inside = cv2.erode(marked, shrink).astype(bool)
     outside = cv2.erode(1 - marked, shrink).astype(bool)
+    step = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
+    second = cv2.erode(marked, step)
+    near_inside = second.astype(bool) & ~cv2.erode(second, step).astype(bool)
     window = (settings.outline_window_px, settings.outline_window_px)
 
     def local_mean(selected: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -250,16 +267,16 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
         return total / np.maximum(weight, 1e-6)[..., None], weight
 
     person_colour, person_weight = local_mean(inside)
+    edge_colour, edge_weight = local_mean(near_inside)
     backdrop_colour, backdrop_weight = local_mean(outside)
     no_backdrop_near = backdrop_weight == 0
     backdrop_colour[no_backdrop_near] = backdrop[no_backdrop_near]
-    contrast = person_colour - backdrop_colour
-    fraction = np.einsum("hwc,hwc->hw", pixels - backdrop_colour, contrast) / np.maximum(
-        np.einsum("hwc,hwc->hw", contrast, contrast), 1e-6
-    )
+    fraction = _mixing_fraction(pixels, person_colour, backdrop_colour)
+    edge_fraction = np.where(edge_weight > 0,
+                             _mixing_fraction(pixels, edge_colour, backdrop_colour), fraction)
     band = ~inside & ~outside & (person_weight > 0)
     refined = region.copy()
-    refined[band] = fraction[band] >= 0.5
+    refined[band] = np.minimum(fraction, edge_fraction)[band] >= 0.5
     labels, stats = _components(refined)
     return labels == int(np.argmax(stats[:, cv2.CC_STAT_AREA])) + 1
 
