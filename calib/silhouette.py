@@ -228,12 +228,12 @@ def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray
 
 
 def _mixing_fraction(pixels: np.ndarray, person: np.ndarray, backdrop: np.ndarray) -> np.ndarray:
-    """(H, W) float32: how much of the person's colour each pixel holds,
-    ``(I - B).(P - B) / |P - B|^2``, for (H, W, 3) float32 ``pixels`` I, ``person`` P and
+    """(N,) float32: how much of the person's colour each pixel holds,
+    ``(I - B).(P - B) / |P - B|^2``, for (N, 3) float32 ``pixels`` I, ``person`` P and
     ``backdrop`` B colours."""
     contrast = person - backdrop
-    return np.einsum("hwc,hwc->hw", pixels - backdrop, contrast) / np.maximum(
-        np.einsum("hwc,hwc->hw", contrast, contrast), 1e-6
+    return np.einsum("nc,nc->n", pixels - backdrop, contrast) / np.maximum(
+        np.einsum("nc,nc->n", contrast, contrast), 1e-6
     )
 
 
@@ -274,12 +274,13 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     backdrop_colour, backdrop_weight = local_mean(outside)
     no_backdrop_near = backdrop_weight == 0
     backdrop_colour[no_backdrop_near] = backdrop[no_backdrop_near]
-    fraction = _mixing_fraction(pixels, person_colour, backdrop_colour)
-    edge_fraction = np.where(edge_weight > 0,
-                             _mixing_fraction(pixels, edge_colour, backdrop_colour), fraction)
     band = ~inside & ~outside & (person_weight > 0)
+    at, backdrop_at = pixels[band], backdrop_colour[band]
+    fraction = _mixing_fraction(at, person_colour[band], backdrop_at)
+    edge_fraction = np.where(edge_weight[band] > 0,
+                             _mixing_fraction(at, edge_colour[band], backdrop_at), fraction)
     refined = region.copy()
-    refined[band] = np.minimum(fraction, edge_fraction)[band] >= 0.5
+    refined[band] = np.minimum(fraction, edge_fraction) >= 0.5
     labels, stats = _components(refined)
     return labels == int(np.argmax(stats[:, cv2.CC_STAT_AREA])) + 1
 
