@@ -33,7 +33,13 @@ scaled the same way, by the front photo's outline width across the deltoids
   and shoulders, and the shoulder breadth, on the deltoids' rounding; for the others 6
   came out better than 2 or 4 on the same fits, if within noise); only the band of rows
   around the tape is rendered (a crop of the camera), so photos of any size cost the
-  same.
+  same. The person's width in a turned photo sums the turned mask's shares of each pixel
+  (:func:`person_width`), not its pixels over one half: a tilted outline's staircase,
+  turned upright, spreads over partial pixels whose threshold would round each row's
+  width to whole pixels again (on a strip tilted 10 degrees, 45.7 px wide, a row's width
+  off by 0.44 px (sd) thresholded, 0.02 px summed; the side photo's neck tape and the
+  arms' are tilted; the held-out fits' neck, wrist and forearm: docs/accuracy.md, step
+  39).
 - The scaling is skipped (the fitted value kept) where the rendered body's outline at
   those rows is not the measurement's own part (an arm against the chest, the jaw over
   the neck in the front photo; in the side photo the jaw's underside, the head's part,
@@ -90,7 +96,8 @@ from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["PHOTO_EXTENTS", "SCALED", "MAX_CHANGE", "MAX_ROW_SPREAD", "MAX_OUTLINE_LEAN_DEG",
-           "SHOULDER_DROP_M", "WRIST_RISE_M", "ViewPhoto", "outline_width", "placed_camera",
+           "SHOULDER_DROP_M", "SHARE_REACH_PX", "WRIST_RISE_M", "ViewPhoto", "outline_width",
+           "person_width", "placed_camera",
            "silhouette_axis", "turned_to_tape", "extent_ratio", "section_scales",
            "scaled_section", "photo_scaled_measurements"]
 
@@ -118,6 +125,9 @@ MAX_ROW_SPREAD = {"B": 0.1}
 MAX_OUTLINE_LEAN_DEG = {"B": 45.0}
 #: The shoulder breadth's line lies this far (metres) below the acromions' midpoint.
 SHOULDER_DROP_M = 0.02
+#: Pixels beyond a run's ends whose shares of the person count to its width
+#: (:func:`person_width`): a bilinear resampling spreads an outline over two.
+SHARE_REACH_PX = 2
 #: The wrist's width is read this far (metres) up the forearm from its tape, whose rows
 #: the thumb's base crosses; the ratio there scales the wrist's section.
 WRIST_RISE_M = 0.03
@@ -155,6 +165,9 @@ class ViewPhoto:
         body: (V, 3) float metres, model frame: the fitted body in the view's pose (the
             side view's arms hanging down), at any scale (the placement follows it).
         visible_parts: the part names the view renders (its camera is placed from them).
+        share: (H, W) float32 in [0, 1], each pixel's share of the person where the mask
+            was resampled (:func:`turned_to_tape`'s warp, whose mask is this over one half),
+            or None: the mask itself.
     """
 
     name: str
@@ -162,6 +175,7 @@ class ViewPhoto:
     intrinsics: np.ndarray
     body: np.ndarray
     visible_parts: tuple[str, ...]
+    share: np.ndarray | None = None
 
 
 def _runs(row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -182,6 +196,24 @@ def outline_width(row: np.ndarray, column: float) -> tuple[int, int]:
     distance = np.maximum(np.maximum(starts - column, column - ends), 0)
     i = int(np.argmin(distance))
     return int(starts[i]), int(ends[i])
+
+
+def person_width(photo: ViewPhoto, row: int, columns: range, run: tuple[int, int]) -> float:
+    """Pixels: the width of the foreground run ``run`` (first, last column within
+    ``columns``) of the photo's mask row ``row``: its length, or where the photo holds a
+    :attr:`ViewPhoto.share`, the shares summed over the run and :data:`SHARE_REACH_PX`
+    pixels either side that no other run holds (a resampled outline's partial pixels,
+    which the mask's threshold rounds to whole ones)."""
+    first, last = run
+    if photo.share is None:
+        return float(last - first + 1)
+    lo = max(columns.start, columns.start + first - SHARE_REACH_PX)
+    hi = min(columns.stop, columns.start + last + SHARE_REACH_PX + 1)
+    shares = photo.share[row, lo:hi].copy()
+    others = photo.mask[row, lo:hi].copy()
+    others[first + columns.start - lo:last + columns.start - lo + 1] = False
+    shares[others] = 0.0
+    return float(shares.sum())
 
 
 def _meets_another_run(row: np.ndarray, run: tuple[int, int], other: tuple[int, int]) -> bool:
@@ -236,7 +268,8 @@ def turned_to_tape(measurer: Measurer, key: str, photo: ViewPhoto,
     view through its centre) runs along a row, the centre's pixel kept where it was: the
     mask warped by the turn's homography (K Rz K^-1, then a shift; bilinear, over half
     covered is person), K shifted by the same, R and t turned by Rz. The line's direction
-    is taken within a quarter turn of the rows, so the photo stays upright."""
+    is taken within a quarter turn of the rows, so the photo stays upright. The turned
+    photo's :attr:`ViewPhoto.share` is the warp before its threshold."""
     rotation, translation = camera
     k = np.asarray(photo.intrinsics, float)
     centre, axis = _tape_line(measurer, photo.body, key, photo.name)
@@ -252,9 +285,9 @@ def turned_to_tape(measurer: Measurer, key: str, photo: ViewPhoto,
     shift[:2, 2] = pixels[0, :2] - moved[:2] / moved[2]
     homography = shift @ homography
     height, width = photo.mask.shape
-    mask = cv2.warpPerspective(photo.mask.astype(np.float32), homography, (width, height),
-                               flags=cv2.INTER_LINEAR) > 0.5
-    turned = dataclasses.replace(photo, mask=mask, intrinsics=shift @ k)
+    share = cv2.warpPerspective(photo.mask.astype(np.float32), homography, (width, height),
+                                flags=cv2.INTER_LINEAR)
+    turned = dataclasses.replace(photo, mask=share > 0.5, share=share, intrinsics=shift @ k)
     return turned, (turn @ rotation, turn @ translation)
 
 
@@ -310,7 +343,7 @@ def extent_ratio(model: BodyModel, measurer: Measurer, key: str, photo: ViewPhot
         if _meets_another_run(rendered, run, (s * first, s * last + s - 1)):
             return None  # the person's outline there holds more (an arm against the chest)
         fitted.append((run[1] - run[0] + 1) / s)
-        person.append(last - first + 1)
+        person.append(person_width(photo, r, columns, (first, last)))
     if np.ptp(np.divide(person, fitted)) > MAX_ROW_SPREAD.get(key, np.inf):
         return None  # the person's outline widens across the band where the body's does not
     lean = np.degrees(np.arctan(np.abs(np.diff(fitted)).mean() / 2.0))
