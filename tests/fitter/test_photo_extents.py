@@ -30,7 +30,6 @@ def test_outline_width_takes_the_run_at_or_nearest_the_column():
     assert outline_width(np.zeros(5, bool), 2.0) == (0, -1)
 
 
-
 def test_person_width_sums_the_shares_of_its_run_and_its_edges():
     """Shares beyond the run count up to SHARE_REACH_PX (2) pixels out, another run's
     pixels not; without shares the width is the run's length."""
@@ -70,6 +69,7 @@ def test_summed_shares_of_a_turned_strip_read_its_width_finer_than_whole_pixels(
     assert abs(np.mean(thresholded)) < 0.1 and abs(np.mean(summed)) < 0.02
     assert np.std(thresholded) > 0.4
     assert np.std(summed) < 0.6 * np.std(thresholded)
+
 
 def _neck_widened(body_model, measurer, vertices: np.ndarray, factor: float,
                   slope: float = 0.0) -> np.ndarray:
