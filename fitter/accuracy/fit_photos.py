@@ -54,8 +54,10 @@ class FitPhotos:
     def of(cls, model: BodyModel, set_folder: Path, subject: str, record: dict) -> "FitPhotos":
         """The subject ``subject`` of the set in ``set_folder`` as run.json's payload
         ``record`` fitted it: its photos are SET/SUBJECT/<the recorded photo's name>, its
-        camera SET/<the recorded camera's name>, wherever the run was made."""
-        settings = run_config(record).settings
+        camera SET/<the recorded camera's name>, wherever the run was made; its views are
+        prepared on the CPU, whatever device the fit ran on (a GPU's fits are measured
+        again on a machine without one)."""
+        settings = dataclasses.replace(run_config(record).settings, device="cpu")
         given = record["inputs"]
         folder = Path(set_folder)
         inputs = PersonInputs(**given | {

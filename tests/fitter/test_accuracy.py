@@ -2,6 +2,7 @@
 small run of the whole benchmark (tools/bench_accuracy.py) whose report must show a
 working fitter."""
 
+import csv
 import dataclasses
 import json
 import os
@@ -145,6 +146,20 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert [r.parent.name for r in records] == sorted(p.parent.name for p in
                                                        subject_set.glob("s*/truth.json"))
     assert "best_betas_per_generation" not in json.loads(records[0].read_text())["result"]
+    # a fit made on a GPU is measured again on a machine without one (its views prepared on
+    # the CPU, whatever its record's device), giving the fit's own measurements back (round
+    # trip: the same measuring code)
+    payload = json.loads(records[0].read_text())
+    records[0].write_text(json.dumps(payload | {"settings": payload["settings"]
+                                                | {"device": "cuda:0"}}))
+    tool("remeasure", str(subject_set), str(kept / "small"), "again")
+    fitted, again = (list(csv.DictReader((folder / "summary.csv").read_text().splitlines()))
+                     for folder in (kept / "small", subject_set / "runs" / "again"))
+    values = [name for name in fitted[0] if name.endswith("_mm") and "spread" not in name]
+    assert len(values) == 16 and [row["id"] for row in again] == [row["id"] for row in fitted]
+    np.testing.assert_allclose([[float(row[name]) for name in values] for row in again],
+                               [[float(row[name]) for name in values] for row in fitted],
+                               atol=0.05)
     shutil.copytree(kept / "small", kept / "first-half")
     lines = (kept / "small" / "summary.csv").read_text().splitlines(keepends=True)
     (kept / "first-half" / "summary.csv").write_text("".join(

@@ -10,7 +10,7 @@ from bodyfit import kernels
 from bodyfit.fitter import photo_extents
 from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
 from bodyfit.fitter.measurements import LIMB_SECTIONS
-from bodyfit.fitter.photo_extents import (MAX_CHANGE, ViewPhoto, extent_ratio,
+from bodyfit.fitter.photo_extents import (MAX_CHANGE, WHOLE_SECTION, ViewPhoto, extent_ratio,
                                           outline_width, person_width,
                                           photo_scaled_measurements, placed_camera,
                                           silhouette_axis, turned_to_tape)
@@ -228,8 +228,9 @@ _LIMB_SHARES = {"G": 0.8, "H": 0.8, "I": 0.6, "M": 0.5, "N": 0.7}
 def _limbs_widened(measurer, vertices: np.ndarray, key: str, factor: float) -> np.ndarray:
     """``vertices`` (V, 3) with each limb ``factor`` times as wide across girth ``key``'s
     tape as the front photo sees it (along its silhouette axis, about the limb's axis
-    through the section's centre), fully near the tape's plane (``_LIMB_REGIONS``), less
-    farther, not at all 4 cm beyond."""
+    through the section's centre; for the tapes of ``WHOLE_SECTION`` as thick every way
+    in the tape's plane), fully near the tape's plane (``_LIMB_REGIONS``), less farther,
+    not at all 4 cm beyond."""
     out = vertices.astype(np.float64).copy()
     regions, full = _LIMB_REGIONS[key]
     for tape, side in zip(LIMB_SECTIONS[key], ("L", "R")):
@@ -240,15 +241,21 @@ def _limbs_widened(measurer, vertices: np.ndarray, key: str, factor: float) -> n
         centre = measurer.girth_centre(out, tape)
         distance = np.abs((out[limb] - origin) @ normal) / np.linalg.norm(normal)
         weight = np.clip(1 - (distance - full) / 0.04, 0, 1)
-        offset = (out[limb] - centre) @ across
-        out[limb] += ((factor - 1) * weight * offset)[:, None] * across
+        if tape in WHOLE_SECTION:  # thicker both ways in the tape's plane
+            offsets = out[limb] - centre
+            offsets -= np.outer(offsets @ normal, normal) / (normal @ normal)
+            out[limb] += (factor - 1) * weight[:, None] * offsets
+        else:
+            offset = (out[limb] - centre) @ across
+            out[limb] += ((factor - 1) * weight * offset)[:, None] * across
     return out
 
 
 @pytest.mark.parametrize("key", ["G", "H", "I", "M", "N"])
 @pytest.mark.parametrize("factor", [1.0, 1.08, 0.93])
 def test_the_limb_girths_follow_the_photo(body_model, measurer, mean_body, key, factor):
-    """Both limbs ``factor`` times as wide across the wrist's, the bicep's, the forearm's,
+    """Both limbs ``factor`` times as wide across the wrist's, the bicep's (as thick every
+    way: its photo's ratio scales the whole section), the forearm's,
     the calf's or the ankle's tapes as the front photo sees them (tilted
     with the A-pose's limbs, some 25-45 px across for the arm's; the forearm reaches
     forward, out of the photo's plane): the girth moves at least 80 % of the way, the
