@@ -2,7 +2,6 @@
 small run of the whole benchmark (tools/bench_accuracy.py) whose report must show a
 working fitter."""
 
-import csv
 import dataclasses
 import json
 import os
@@ -21,7 +20,9 @@ from bodyfit.fitter.accuracy.bodies import draw_bodies, flexion_rotations, pose_
 from bodyfit.fitter.accuracy.photos import PhotoEffects, record
 from bodyfit.fitter.accuracy.report import ISO_ALLOWANCE_MM, iso_verdicts
 from bodyfit.fitter.accuracy.scores import error_stats
+from bodyfit.fitter.batch.tables import SUMMARY_COLUMNS, SUMMARY_FILE, read_table
 from bodyfit.fitter.body_model import forward, project_shape, rest_shape
+from bodyfit.fitter.measurements import MEASUREMENTS
 from bodyfit.fitter.model_cache import CACHE_ENV_VAR
 from bodyfit.fitter.side_arms import side_photo_pose
 from bodyfit.fitter.spreads import read_calibration
@@ -153,10 +154,10 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     records[0].write_text(json.dumps(payload | {"settings": payload["settings"]
                                                 | {"device": "cuda:0"}}))
     tool("remeasure", str(subject_set), str(kept / "small"), "again")
-    fitted, again = (list(csv.DictReader((folder / "summary.csv").read_text().splitlines()))
+    fitted, again = (read_table(folder / SUMMARY_FILE, SUMMARY_COLUMNS)
                      for folder in (kept / "small", subject_set / "runs" / "again"))
-    values = [name for name in fitted[0] if name.endswith("_mm") and "spread" not in name]
-    assert len(values) == 16 and [row["id"] for row in again] == [row["id"] for row in fitted]
+    values = [f"{name}_mm" for name, _ in MEASUREMENTS.values()]
+    assert len(fitted) == 4 and [row["id"] for row in again] == [row["id"] for row in fitted]
     np.testing.assert_allclose([[float(row[name]) for name in values] for row in again],
                                [[float(row[name]) for name in values] for row in fitted],
                                atol=0.05)

@@ -237,7 +237,6 @@ def _limbs_widened(measurer, vertices: np.ndarray, key: str, factor: float) -> n
         limb = np.concatenate([measurer.landmarks[f"region:{region}.{side}"]
                                for region in regions])
         origin, normal = measurer.girth_plane(out, tape)
-        across = silhouette_axis(measurer, out, tape, "front")
         centre = measurer.girth_centre(out, tape)
         distance = np.abs((out[limb] - origin) @ normal) / np.linalg.norm(normal)
         weight = np.clip(1 - (distance - full) / 0.04, 0, 1)
@@ -246,6 +245,7 @@ def _limbs_widened(measurer, vertices: np.ndarray, key: str, factor: float) -> n
             offsets -= np.outer(offsets @ normal, normal) / (normal @ normal)
             out[limb] += (factor - 1) * weight[:, None] * offsets
         else:
+            across = silhouette_axis(measurer, out, tape, "front")
             offset = (out[limb] - centre) @ across
             out[limb] += ((factor - 1) * weight * offset)[:, None] * across
     return out
