@@ -26,6 +26,9 @@
     # the calibrated ± (fitter/spreads.py): the factors a run gives, how often the truth
     # lies within bodyfit's calibration's ±; --write makes a calibration of the run's
     python tools/bench_accuracy.py spread SETS/out default --write fitter/data/spread_calibration.json
+    # ... a calibration made from some rows tested on others
+    python tools/bench_accuracy.py spread SETS/out default --first 50 --write /tmp/first50.json
+    python tools/bench_accuracy.py spread SETS/out default --first 100 --skip 50 --calibration /tmp/first50.json
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # does the cost tell the truth's closest body from the fit's answer (search or photos?)
@@ -98,7 +101,8 @@ from bodyfit.fitter.plots import line_chart
 from bodyfit.fitter.run_config import read_run_config, run_config
 from bodyfit.fitter.sections import hull_perimeter
 from bodyfit.fitter.spreads import (SpreadCalibration, bodyfit_calibration,
-                                    calibration_applies, recorded_answer_cost)
+                                    calibration_applies, read_calibration,
+                                    recorded_answer_cost)
 from bodyfit.fitter.stature import scaled_to_stature
 from bodyfit.fitter.studio_photos import pinhole_silhouette
 
@@ -591,8 +595,8 @@ def combine(args) -> None:
 def spread(args) -> None:
     """The calibrated ± (:mod:`bodyfit.fitter.spreads`) on a run's fits: the factors its
     subjects give (each measurement's quantile of |error| / answer cost), and how often the
-    truth lies within the ± of bodyfit's own calibration (``fitter/data``; a test of it on
-    subjects it was not made from) and within the fits' own reported spreads. ``--write
+    truth lies within the ± of bodyfit's own calibration (``fitter/data``), or of
+    ``--calibration FILE``'s (a test of it on subjects it was not made from), and within the fits' own reported spreads. ``--write
     FILE`` writes the run's factors as a calibration. (On the subjects it is made from, a
     calibration holds the truth for its coverage by construction, and so would each
     subject left out of it: the quantile's rank does not depend on the errors.) Last, how
@@ -605,17 +609,19 @@ def spread(args) -> None:
                       for s in scores.ids])
     made = SpreadCalibration.made_from(scores.errors, costs,
                                        "python tools/bench_accuracy.py " + " ".join(sys.argv[1:]))
-    own = bodyfit_calibration()
+    own = (read_calibration(Path(args.calibration).read_text()) if args.calibration
+           else bodyfit_calibration())
+    tested = f"{args.calibration}'s" if args.calibration else "bodyfit's"
     absolute = np.abs(scores.errors)
-    columns = {f"bodyfit's calibration ({own.subjects} subjects)": np.mean(
+    columns = {f"{tested} calibration ({own.subjects} subjects)": np.mean(
                    absolute <= np.array([list(own.spreads(c).values()) for c in costs]), axis=0),
                "the same, unscaled (its ± at its median cost)": np.mean(
                    absolute <= np.array(list(own.spreads(own.median_cost).values())), axis=0),
                "the fits' reported spreads": np.mean(absolute <= scores.spreads, axis=0)}
     print(f"{folder}: {'+'.join(args.names)}, {len(costs)} subjects; answer cost (weighted mm) "
-          f"median {np.median(costs):.1f}, {costs.min():.1f}-{costs.max():.1f} (bodyfit's "
+          f"median {np.median(costs):.1f}, {costs.min():.1f}-{costs.max():.1f} ({tested} "
           f"calibration's median {own.median_cost:.1f})\n\n"
-          "| measurement | these fits' factor (mm per weighted mm) | bodyfit's | truth within: "
+          f"| measurement | these fits' factor (mm per weighted mm) | {tested} | truth within: "
           + " | ".join(columns) + " |\n|---|---|---|" + "---|" * len(columns))
     for j, (key, (_, label)) in enumerate(MEASUREMENTS.items()):
         print(f"| {key} {label} | {made.per_cost[key]:.3f} | {own.per_cost[key]:.3f} | "
@@ -888,6 +894,9 @@ def main() -> None:
     p.add_argument("--write", metavar="FILE",
                    help="write the run's factors as a calibration (bodyfit's own: "
                    "fitter/data/spread_calibration.json)")
+    p.add_argument("--calibration", metavar="FILE",
+                   help="test this calibration (one `--write` made, e.g. from other rows) "
+                   "instead of bodyfit's own")
     p = sub.add_parser("report", help="Markdown tables of runs")
     p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "

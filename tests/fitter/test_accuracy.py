@@ -232,6 +232,15 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
     assert factors.keys() == calibration.per_cost.keys()
     for key, factor in factors.items():
         assert float(factor) == pytest.approx(calibration.per_cost[key], abs=5e-4)
+    # ... tested on its own 4 subjects instead of bodyfit's: each factor is the 68.3 %
+    # quantile of 4 ratios, between the third and the fourth, so the truth lies within
+    # for 3 of the 4 (all 4 where those two tie)
+    printed = tool("spread", str(subject_set), "small", "--calibration", str(written))
+    assert f"{written}'s calibration (4 subjects)" in printed
+    rows = re.findall(r"^\| ([A-P]) [^|]+\| ([.\d]+) \| ([.\d]+) \| (\d+)% \|", printed, re.M)
+    assert [key for key, *_ in rows] == list(calibration.per_cost)
+    for key, made, tested, within in rows:
+        assert made == tested and within in ("75", "100")
     # the truth's closest body scored on the fit's views: drawn from the space the fit
     # searches, it is cheaper than a 60-generation search's answer
     printed = tool("costs", str(subject_set), "small", "--first", "2")
