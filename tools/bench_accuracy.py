@@ -28,7 +28,8 @@
     python tools/bench_accuracy.py spread SETS/out default --write fitter/data/spread_calibration.json
     # ... a calibration made from some rows tested on others
     python tools/bench_accuracy.py spread SETS/out default --first 50 --write /tmp/first50.json
-    python tools/bench_accuracy.py spread SETS/out default --first 100 --skip 50 --calibration /tmp/first50.json
+    python tools/bench_accuracy.py spread SETS/out default --first 100 --skip 50 \
+        --calibration /tmp/first50.json
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # does the cost tell the truth's closest body from the fit's answer (search or photos?)
@@ -595,12 +596,14 @@ def combine(args) -> None:
 def spread(args) -> None:
     """The calibrated ± (:mod:`bodyfit.fitter.spreads`) on a run's fits: the factors its
     subjects give (each measurement's quantile of |error| / answer cost), and how often the
-    truth lies within the ± of bodyfit's own calibration (``fitter/data``), or of
-    ``--calibration FILE``'s (a test of it on subjects it was not made from), and within the fits' own reported spreads. ``--write
-    FILE`` writes the run's factors as a calibration. (On the subjects it is made from, a
-    calibration holds the truth for its coverage by construction, and so would each
-    subject left out of it: the quantile's rank does not depend on the errors.) Last, how
-    well a fit's answer cost and its reported spread rank the subjects by their errors."""
+    truth lies within the ± of bodyfit's own calibration (``fitter/data``) or of
+    ``--calibration FILE``'s (a test of it on subjects it was not made from), and within
+    the fits' own reported spreads. ``--write FILE`` writes the run's factors as a
+    calibration. (On the subjects it is made from, a calibration holds the truth for its
+    coverage by construction, and so would each subject left out of it: the quantile's
+    rank does not depend on the errors.) Last, how well a fit's answer cost and its
+    reported spread rank the subjects by their errors."""
+    own, tested = _tested_calibration(args.calibration)
     folder = Path(args.set)
     runs = [_run_folder(folder, name) for name in args.names]
     scores, _ = _run_scores(folder, runs, args.first, args.skip)
@@ -609,9 +612,6 @@ def spread(args) -> None:
                       for s in scores.ids])
     made = SpreadCalibration.made_from(scores.errors, costs,
                                        "python tools/bench_accuracy.py " + " ".join(sys.argv[1:]))
-    own = (read_calibration(Path(args.calibration).read_text()) if args.calibration
-           else bodyfit_calibration())
-    tested = f"{args.calibration}'s" if args.calibration else "bodyfit's"
     absolute = np.abs(scores.errors)
     columns = {f"{tested} calibration ({own.subjects} subjects)": np.mean(
                    absolute <= np.array([list(own.spreads(c).values()) for c in costs]), axis=0),
@@ -641,6 +641,17 @@ def spread(args) -> None:
     if args.write:
         write_text(Path(args.write), json.dumps(made.as_json(), indent=2) + "\n")
         print(f"\nwrote {args.write}")
+
+
+def _tested_calibration(path: str | None) -> tuple[SpreadCalibration, str]:
+    """The calibration ``spread`` tests, with its name for the table: bodyfit's own, or
+    the one in the file ``path`` (exits with one line if it is not a readable one)."""
+    if path is None:
+        return bodyfit_calibration(), "bodyfit's"
+    try:
+        return read_calibration(Path(path).read_text()), f"{path}'s"
+    except (OSError, ValueError, KeyError) as error:
+        sys.exit(f"{path}: not a readable spread calibration ({error})")
 
 
 def _beyond_the_neck(measurer: Measurer, vertices: np.ndarray,

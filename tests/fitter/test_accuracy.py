@@ -261,6 +261,21 @@ def test_small_benchmark_runs_through_the_users_pipeline(tmp_path):
         [line.split(",")[0], "fitted earlier"] for line in before[3:]]
 
 
+@pytest.mark.parametrize("text", [None, "not json", '{"format": "other"}',
+                                  '{"format": "bodyfit.spread_calibration/1"}'])
+def test_spread_refuses_a_calibration_file_it_cannot_read(tmp_path, text):
+    """`spread --calibration FILE`: a missing, corrupt or foreign file is one line and a
+    non-zero exit, before any run is read."""
+    calibration = tmp_path / "calibration.json"
+    if text is not None:
+        calibration.write_text(text)
+    done = subprocess.run([sys.executable, str(TOOL), "spread", str(tmp_path), "run",
+                           "--calibration", str(calibration)], capture_output=True, text=True)
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.stderr.strip().splitlines()[-1].startswith(
+        f"{calibration}: not a readable spread calibration (")
+
+
 def test_failures_are_counted_by_reason():
     from bodyfit.fitter.accuracy.report import failure_lines
     from bodyfit.fitter.accuracy.scores import RunScores
