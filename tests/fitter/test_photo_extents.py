@@ -1,6 +1,7 @@
 """Girths and the shoulder breadth scaled to the photos' extents: a person whose neck is
-wider (or deeper), or whose shoulders are broader, than the fitted body's, photographed
-through a known camera, gives back that neck's girth or those shoulders' breadth."""
+wider (or deeper), whose chest is deeper, or whose shoulders are broader, than the fitted
+body's, photographed through a known camera, gives back that girth or those shoulders'
+breadth."""
 
 import cv2
 import numpy as np
@@ -15,6 +16,7 @@ from bodyfit.fitter.photo_extents import (MAX_CHANGE, WHOLE_SECTION, ViewPhoto, 
                                           photo_scaled_measurements, placed_camera,
                                           silhouette_axis, turned_to_tape)
 from bodyfit.fitter.pinhole_canvas import Placement
+from bodyfit.fitter.side_arms import side_photo_pose
 
 PHOTO_SHAPE = (1600, 1200)
 K = np.array([[1500.0, 0, 599.5], [0, 1500.0, 799.5], [0, 0, 1]])
@@ -85,14 +87,17 @@ def _neck_widened(body_model, measurer, vertices: np.ndarray, factor: float,
     return out
 
 
-def _neck_deepened(measurer, vertices: np.ndarray, factor: float) -> np.ndarray:
-    """``vertices`` (V, 3) with the neck ``factor`` times as deep front to back at its tape,
-    the throat's front (the head's part) with it: each vertex's y scaled about the tape's
-    centre, fully on its plane, less with the distance from it, not at all 3 cm away."""
+def _deepened(measurer, vertices: np.ndarray, key: str, factor: float,
+              reach: float) -> np.ndarray:
+    """``vertices`` (V, 3) with the body ``factor`` times as deep front to back at girth
+    ``key``'s tape (the neck's: the throat's front, the head's part, with it): each
+    vertex's y scaled about the tape's centre, fully on its plane, less with the distance
+    from it, not at all ``reach`` metres away."""
     out = vertices.astype(np.float64).copy()
-    origin, normal = measurer.girth_plane(out, "B")
-    weight = np.clip(1 - np.abs((out - origin) @ normal) / np.linalg.norm(normal) / 0.03, 0, 1)
-    centre = measurer.girth_centre(out, "B")[1]
+    origin, normal = measurer.girth_plane(out, key)
+    distance = np.abs((out - origin) @ normal) / np.linalg.norm(normal)
+    weight = np.clip(1 - distance / reach, 0, 1)
+    centre = measurer.girth_centre(out, key)[1]
     out[:, 1] = centre + (1 + (factor - 1) * weight) * (out[:, 1] - centre)
     return out
 
@@ -165,7 +170,23 @@ def test_the_neck_girth_follows_the_side_photo(body_model, measurer, mean_body, 
     its tape tilted in the photo): the girth moves at least two thirds of the way (the
     band's rows either side of the tape see less of the deepening)."""
     _follows(body_model, measurer, mean_body, "B", "side",
-             lambda v, f: _neck_deepened(measurer, v, f), factor, 2 / 3)
+             lambda v, f: _deepened(measurer, v, "B", f, 0.03), factor, 2 / 3)
+
+
+@pytest.mark.parametrize("key", ["D", "E"])
+@pytest.mark.parametrize("factor", [1.0, 1.06, 0.95])
+def test_the_chest_and_waist_girths_follow_the_side_photo(body_model, measurer, mean_body,
+                                                          key, factor):
+    """The trunk ``factor`` times as deep at the chest's or the waist's tape, fully there
+    and less over 10 cm up and down, seen from the side with the arms hanging down (as
+    people stand for it; the trunk some 110-130 px deep): the girth moves at least 80 %
+    of the way."""
+    _, rest = mean_body
+    betas = np.zeros(20)
+    pose = side_photo_pose(body_model, betas, np.zeros(len(POSE_NAMES)))
+    arms_down = forward(body_model, betas[None], pose[None])[0].astype(np.float64)
+    _follows(body_model, measurer, (arms_down, rest), key, "side",
+             lambda v, f: _deepened(measurer, v, key, f, 0.1), factor, 0.8)
 
 
 @pytest.mark.parametrize("view", ["front", "side"])
