@@ -179,7 +179,7 @@ def test_the_chest_and_waist_girths_follow_the_side_photo(body_model, measurer, 
                                                           key, factor):
     """The trunk ``factor`` times as deep at the chest's or the waist's tape, fully there
     and less over 10 cm up and down, seen from the side with the arms hanging down (as
-    people stand for it; the trunk some 110-130 px deep): the girth moves at least 80 %
+    people stand for it; the trunk some 125-135 px deep): the girth moves at least 80 %
     of the way."""
     _, rest = mean_body
     betas = np.zeros(20)
