@@ -30,6 +30,8 @@
     python tools/bench_accuracy.py spread SETS/out default --first 50 --write /tmp/first50.json
     python tools/bench_accuracy.py spread SETS/out default --first 100 --skip 50 \
         --calibration /tmp/first50.json
+    # each measurement's signed error against the front photo's limb bends (out-of-space)
+    python tools/bench_accuracy.py bends SETS/out default
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # does the cost tell the truth's closest body from the fit's answer (search or photos?)
@@ -848,6 +850,42 @@ def figures(args) -> None:
     print(f"wrote {args.docs}/accuracy_error_per_generation.png, {args.docs}/accuracy_meshes.png")
 
 
+def bends(args) -> None:
+    """How each measurement's signed error follows the front photo's limb bends, which
+    the fit's rig cannot make (out-of-space sets: each chain swung forward or back by up
+    to ``flexion_deg``, :mod:`bodyfit.fitter.accuracy.bodies`). Per measurement and per
+    pair of chains (the arms, the legs: their mean bend, degrees): Spearman's rank
+    correlation with the signed error, the least-squares slope (mm per degree), and the
+    mean |error| with that linear share taken out, fitted on the same subjects (so an upper
+    bound of what modelling the bend could gain)."""
+    folder = Path(args.set)
+    scores, _ = _run_scores(folder, [_run_folder(folder, name) for name in args.names],
+                            args.first, args.skip)
+    bodies = read_bodies(load_model(), folder)
+    if not bodies.flexion_deg.any():
+        sys.exit(f"bends: {folder}'s photos bend no limb (an in-space set)")
+    rows = [subject_ids(len(bodies.sex), bodies.sex).index(s) for s in scores.ids]
+    chains = {limbs: [POSE_NAMES.index(f"{joint}_abduction_{side}") for side in ("left", "right")]
+              for limbs, joint in (("arms", "shoulder"), ("legs", "hip"))}
+    bend = {name: bodies.flexion_deg[rows][:, columns].mean(axis=1)
+            for name, columns in chains.items()}
+    print(f"{folder}: {'+'.join(args.names)}, {len(rows)} subjects; the front photo's bend "
+          "(degrees, + forward): arms' mean |bend| "
+          f"{np.abs(bend['arms']).mean():.2f}, legs' {np.abs(bend['legs']).mean():.2f}\n\n"
+          "| measurement | mean abs. error (mm) | "
+          + " | ".join(f"{name}: rho, mm per degree, abs. error without" for name in chains)
+          + " |\n|" + "---|" * (2 + len(chains)))
+    for column, key in enumerate(KEYS):
+        error = scores.errors[:, column]
+        cells = []
+        for angle in bend.values():
+            slope = np.polyfit(angle, error, 1)[0]
+            cells.append(f"{stats.spearmanr(angle, error).statistic:+.2f}, {slope:+.2f}, "
+                         f"{np.abs(error - slope * (angle - angle.mean())).mean():.2f}")
+        print(f"| {key} {MEASUREMENTS[key][1]} | {np.abs(error).mean():.2f} | "
+              + " | ".join(cells) + " |")
+
+
 def _joined_runs_parser(sub, command: str, description: str) -> argparse.ArgumentParser:
     """A subcommand over a set and runs of it joined, with ``--first``."""
     p = sub.add_parser(command, help=description)
@@ -908,6 +946,10 @@ def main() -> None:
     p.add_argument("--calibration", metavar="FILE",
                    help="test this calibration (one `--write` made, e.g. from other rows) "
                    "instead of bodyfit's own")
+    p = _joined_runs_parser(sub, "bends", "each measurement's signed error against the "
+                            "front photo's limb bends (out-of-space)")
+    p.add_argument("--skip", type=int, default=0, metavar="I",
+                   help="with --first N: rows I to N - 1 only")
     p = sub.add_parser("report", help="Markdown tables of runs")
     p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "
@@ -961,7 +1003,8 @@ def main() -> None:
     else:
         {"make": make, "keep": keep, "combine": combine, "report": report,
          "outlines": outlines, "floor": floor, "costs": costs, "budgets": budgets,
-         "figures": figures, "spread": spread, "remeasure": remeasure}[args.command](args)
+         "figures": figures, "spread": spread, "remeasure": remeasure,
+         "bends": bends}[args.command](args)
 
 
 if __name__ == "__main__":
