@@ -864,7 +864,8 @@ def bends(args) -> None:
     bodies = read_bodies(load_model(), folder)
     if not bodies.flexion_deg.any():
         sys.exit(f"bends: {folder}'s photos bend no limb (an in-space set)")
-    rows = [subject_ids(len(bodies.sex), bodies.sex).index(s) for s in scores.ids]
+    row_of = {subject: row for row, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex))}
+    rows = [row_of[subject] for subject in scores.ids]
     chains = {limbs: [POSE_NAMES.index(f"{joint}_abduction_{side}") for side in ("left", "right")]
               for limbs, joint in (("arms", "shoulder"), ("legs", "hip"))}
     bend = {name: bodies.flexion_deg[rows][:, columns].mean(axis=1)
@@ -886,14 +887,19 @@ def bends(args) -> None:
               + " | ".join(cells) + " |")
 
 
-def _joined_runs_parser(sub, command: str, description: str) -> argparse.ArgumentParser:
-    """A subcommand over a set and runs of it joined, with ``--first``."""
+def _joined_runs_parser(sub, command: str, description: str,
+                        skip_example: str | None = None) -> argparse.ArgumentParser:
+    """A subcommand over a set and runs of it joined, with ``--first``, and with ``--skip``
+    where ``skip_example`` says what rows it leaves out for."""
     p = sub.add_parser(command, help=description)
     p.add_argument("set")
     p.add_argument("names", nargs="+", metavar="name",
                    help="runs (SET/runs/NAME, or a folder of `keep`), joined: each "
                    "subject from the first")
     p.add_argument("--first", type=int, help="the set's first N subjects only")
+    if skip_example is not None:
+        p.add_argument("--skip", type=int, default=0, metavar="I",
+                       help=f"with --first N: rows I to N - 1 only (e.g. {skip_example})")
     return p
 
 
@@ -936,10 +942,8 @@ def main() -> None:
     p.add_argument("--answers", type=int, metavar="N",
                    help="each fit's first N answers only (as --refinements N would give)")
     p = _joined_runs_parser(sub, "spread", "the calibrated ± on a run's fits: their factors, "
-                            "how often the truth lies within")
-    p.add_argument("--skip", type=int, default=0, metavar="I",
-                   help="with --first N: rows I to N - 1 only (e.g. rows a calibration was "
-                   "not made from)")
+                            "how often the truth lies within",
+                            skip_example="rows a calibration was not made from")
     p.add_argument("--write", metavar="FILE",
                    help="write the run's factors as a calibration (bodyfit's own: "
                    "fitter/data/spread_calibration.json)")
@@ -947,9 +951,8 @@ def main() -> None:
                    help="test this calibration (one `--write` made, e.g. from other rows) "
                    "instead of bodyfit's own")
     p = _joined_runs_parser(sub, "bends", "each measurement's signed error against the "
-                            "front photo's limb bends (out-of-space)")
-    p.add_argument("--skip", type=int, default=0, metavar="I",
-                   help="with --first N: rows I to N - 1 only")
+                            "front photo's limb bends (out-of-space)",
+                            skip_example="subjects held out from every choice")
     p = sub.add_parser("report", help="Markdown tables of runs")
     p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "
