@@ -32,6 +32,8 @@
         --calibration /tmp/first50.json
     # each measurement's signed error against the front photo's limb bends (out-of-space)
     python tools/bench_accuracy.py bends SETS/out default
+    # the photo readings with the front body bent by the truth's angles or the estimate
+    python tools/bench_accuracy.py bend-readings SETS/out default --first 72
     # the space's floor: the error of each true body's closest body of K components
     python tools/bench_accuracy.py floor SETS/out --first 100 --components 20 40 60
     # does the cost tell the truth's closest body from the fit's answer (search or photos?)
@@ -77,6 +79,7 @@ from scipy import stats
 
 from bodyfit.calib.images import write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
+from bodyfit.fitter.accuracy import bend_readings as bend_probes
 from bodyfit.fitter.accuracy.bodies import KINDS, pose_bodies
 from bodyfit.fitter.accuracy.fit_photos import FitPhotos, answer_pose
 from bodyfit.fitter.accuracy.figures import (colour_bar, distance_panel, errors_per_generation,
@@ -887,6 +890,57 @@ def bends(args) -> None:
               + " | ".join(cells) + " |")
 
 
+def bend_readings(args) -> None:
+    """What the front photo's limb bends do to the photo readings, fit by fit (out-of-space
+    sets; :mod:`bodyfit.fitter.accuracy.bend_readings`): the bicep's front width per degree
+    of the benchmark's swing against a pure tilt (the truth's section); how well the front
+    photo tells each arm's swing; each photo-read measurement's mean |error| as the fit
+    reads it and with its front body bent by the truth's angles or by the estimate,
+    paired differences with their 95 % intervals (Student t)."""
+    folder = Path(args.set)
+    model = load_model()
+    measurer = Measurer.from_model(model)
+    bodies = read_bodies(model, folder)
+    if not bodies.flexion_deg.any():
+        sys.exit(f"bend-readings: {folder}'s photos bend no limb (an in-space set)")
+    ids = subject_ids(len(bodies.sex), bodies.sex)
+    wanted = ids[args.skip:args.first]
+    holders = _record_holders([_run_folder(folder, name) for name in args.names], wanted)
+    subjects = [s for s in wanted if s in holders]
+    row_of = {subject: row for row, subject in enumerate(ids)}
+    twists, errors, estimates = [], [], []
+    for subject in subjects:
+        row = row_of[subject]
+        twists.append(bend_probes.twist_width_change(model, measurer, bodies, row))
+        error, estimate = bend_probes.bend_readings(model, measurer, bodies, row, folder,
+                                                    holders[subject], subject)
+        errors.append(error)
+        estimates.append(estimate[:2])
+    twists, errors, estimates = np.array(twists), np.array(errors), np.array(estimates)
+    truth = bodies.flexion_deg[[row_of[s] for s in subjects]][:, :2]
+    print(f"{folder}: {'+'.join(args.names)}, {len(subjects)} subjects\n\n"
+          f"- the left bicep's front width (the truth's section, orthographic): "
+          f"{twists[:, 0].mean():+.3f} % per degree swung about the model's x axis (range "
+          f"{twists[:, 0].min():+.3f} to {twists[:, 0].max():+.3f}), {twists[:, 1].mean():+.3f} "
+          "tilted towards the camera\n- the arms' swing estimated from the front photo: "
+          f"r {np.corrcoef(truth.ravel(), estimates.ravel())[0, 1]:.2f} with the truth's, "
+          f"mean |estimate - truth| {np.abs(estimates - truth).mean():.2f} degrees (the "
+          f"truth's mean |swing| {np.abs(truth).mean():.2f})\n")
+    absolute = np.abs(errors)  # (S, variants, measurements)
+    variants = bend_probes.VARIANTS
+    print("| measurement | " + " | ".join(
+        f"{v} (mm)" if i == 0 else f"{v}: mm, paired (95 % CI)" for i, v in enumerate(variants))
+        + " |\n|" + "---|" * (1 + len(variants)))
+    for column, key in enumerate(SCALED):
+        cells = [f"{absolute[:, 0, column].mean():.2f}"]
+        for variant in range(1, len(variants)):
+            s = error_stats(absolute[:, variant, column:column + 1]
+                            - absolute[:, 0, column:column + 1])
+            cells.append(f"{absolute[:, variant, column].mean():.2f}, {s.bias[0]:+.2f} "
+                         f"(±{s.bias_ci[0]:.2f})")
+        print(f"| {key} {MEASUREMENTS[key][1]} | " + " | ".join(cells) + " |")
+
+
 def _joined_runs_parser(sub, command: str, description: str,
                         skip_example: str | None = None) -> argparse.ArgumentParser:
     """A subcommand over a set and runs of it joined, with ``--first``, and with ``--skip``
@@ -953,6 +1007,9 @@ def main() -> None:
     p = _joined_runs_parser(sub, "bends", "each measurement's signed error against the "
                             "front photo's limb bends (out-of-space)",
                             skip_example="subjects held out from every choice")
+    _joined_runs_parser(sub, "bend-readings", "the photo readings with the front body bent by "
+                        "the truth's angles or the photo's estimate (out-of-space)",
+                        skip_example="subjects held out from every choice")
     p = sub.add_parser("report", help="Markdown tables of runs")
     p.add_argument("--main", action="append", default=[], metavar="LABEL=SET:RUN",
                    help="a run with its full Table 3 form (RUN: a name of SET/runs/, or a "
@@ -1007,7 +1064,7 @@ def main() -> None:
         {"make": make, "keep": keep, "combine": combine, "report": report,
          "outlines": outlines, "floor": floor, "costs": costs, "budgets": budgets,
          "figures": figures, "spread": spread, "remeasure": remeasure,
-         "bends": bends}[args.command](args)
+         "bends": bends, "bend-readings": bend_readings}[args.command](args)
 
 
 if __name__ == "__main__":
