@@ -4,9 +4,9 @@ The out-of-space bodies swing each limb forward or back in the front photo
 (:func:`~bodyfit.fitter.accuracy.bodies.flexion_rotations`, about the model's x axis),
 which the fit's rig cannot. Two probes:
 
-- :func:`twist_width_change`: the rest A-pose's arm hangs some 42 degrees out from the
-  body, so a swing about the model's x axis also turns the arm about its own axis (by the
-  swing times the sine of that angle); the bicep's section is not round, so its width
+- :func:`twist_width_change`: the rest A-pose's upper arm hangs some 42-45 degrees out
+  from the body, so a swing about the model's x axis also turns the arm about its own
+  axis (by the swing times the sine of that angle, the arm's direction's x component); the bicep's section is not round, so its width
   across the front view changes with the turn. Measured on the truth's own section
   (orthographic, no photo): the swing against a pure tilt of the arm towards the camera
   (about the axis across it in the front view), which turns nothing.
@@ -37,8 +37,7 @@ from bodyfit.fitter.photo_extents import (SCALED, ViewPhoto, photo_scaled_measur
 from bodyfit.kernels.body_forward import blend_skinning
 
 __all__ = ["VARIANTS", "SWING_GRID_DEG", "ABDUCTION_GRID_DEG", "HEAD_ROWS_SHARE",
-           "twist_width_change",
-           "estimate_arm_swing", "bend_readings"]
+           "twist_width_change", "estimate_arm_swing", "bend_readings"]
 
 #: The readings :func:`bend_readings` compares, in its order.
 VARIANTS = ("fit", "truth's arms", "truth's legs", "truth's bends", "estimated arms")
