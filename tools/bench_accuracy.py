@@ -853,6 +853,10 @@ def figures(args) -> None:
     print(f"wrote {args.docs}/accuracy_error_per_generation.png, {args.docs}/accuracy_meshes.png")
 
 
+def _rows_of(bodies) -> dict[str, int]:
+    """subject id -> its row of the set's ``bodies``, in the set's order."""
+    return {subject: row for row, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex))}
+
 def bends(args) -> None:
     """How each measurement's signed error follows the front photo's limb bends, which
     the fit's rig cannot make (out-of-space sets: each chain swung forward or back by up
@@ -867,7 +871,7 @@ def bends(args) -> None:
     bodies = read_bodies(load_model(), folder)
     if not bodies.flexion_deg.any():
         sys.exit(f"bends: {folder}'s photos bend no limb (an in-space set)")
-    row_of = {subject: row for row, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex))}
+    row_of = _rows_of(bodies)
     rows = [row_of[subject] for subject in scores.ids]
     chains = {limbs: [POSE_NAMES.index(f"{joint}_abduction_{side}") for side in ("left", "right")]
               for limbs, joint in (("arms", "shoulder"), ("legs", "hip"))}
@@ -903,11 +907,10 @@ def bend_readings(args) -> None:
     bodies = read_bodies(model, folder)
     if not bodies.flexion_deg.any():
         sys.exit(f"bend-readings: {folder}'s photos bend no limb (an in-space set)")
-    ids = subject_ids(len(bodies.sex), bodies.sex)
-    wanted = ids[args.skip:args.first]
+    row_of = _rows_of(bodies)
+    wanted = list(row_of)[args.skip:args.first]
     holders = _record_holders([_run_folder(folder, name) for name in args.names], wanted)
     subjects = [s for s in wanted if s in holders]
-    row_of = {subject: row for row, subject in enumerate(ids)}
     twists, errors, estimates = [], [], []
     for subject in subjects:
         row = row_of[subject]

@@ -6,8 +6,9 @@ which the fit's rig cannot. Two probes:
 
 - :func:`twist_width_change`: the rest A-pose's upper arm hangs some 42-45 degrees out
   from the body, so a swing about the model's x axis also turns the arm about its own
-  axis (by the swing times the sine of that angle, the arm's direction's x component); the bicep's section is not round, so its width
-  across the front view changes with the turn. Measured on the truth's own section
+  axis (by the swing times the sine of that angle, the arm's direction's x component);
+  the bicep's section is not round, so its width across the front view changes with
+  the turn. Measured on the truth's own section
   (orthographic, no photo): the swing against a pure tilt of the arm towards the camera
   (about the axis across it in the front view), which turns nothing.
 - :func:`bend_readings`: a fit's photo readings (:data:`~bodyfit.fitter.photo_extents.
@@ -27,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from bodyfit import kernels
-from bodyfit.fitter.accuracy.bodies import Bodies, flexion_rotations
+from bodyfit.fitter.accuracy.bodies import Bodies, bent_bodies, flexion_rotations
 from bodyfit.fitter.accuracy.fit_photos import FitPhotos, answer_pose
 from bodyfit.fitter.body_model import BodyModel, abduction_rotations, rest_shape
 from bodyfit.fitter.fit import fitted_bodies, view_photos
@@ -47,16 +48,6 @@ ABDUCTION_GRID_DEG = np.arange(-2.0, 2.01, 0.5)
 #: The head: the silhouette's top rows, this share of its height (:func:`_head_centred`).
 HEAD_ROWS_SHARE = 0.08
 _ARMS, _LEGS = [0, 1], [2, 3]  # POSE_NAMES columns
-
-
-def _bent(model: BodyModel, rest: np.ndarray, joints: np.ndarray, pose_deg: np.ndarray,
-          swing_deg: np.ndarray) -> np.ndarray:
-    """(P, V, 3) float32 metres: the rest body (V, 3) with its joints (4, 3) posed by each
-    row of ``pose_deg`` (P, 4) abduction angles after ``swing_deg`` (P, 4) swings."""
-    rotations = abduction_rotations(pose_deg) @ flexion_rotations(swing_deg)
-    count = len(pose_deg)
-    return blend_skinning(model.chain_weights, np.repeat(rest[None], count, 0),
-                          np.repeat(joints[None], count, 0), rotations)
 
 
 def _axis_rotation(axis: np.ndarray, degrees: float) -> np.ndarray:
@@ -94,9 +85,8 @@ def twist_width_change(model: BodyModel, measurer: Measurer, bodies: Bodies, row
     return changes[0], changes[1]
 
 
-def _head_centred(model: BodyModel, photo: ViewPhoto, rest: np.ndarray, joints: np.ndarray,
-                  pose_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(R (3, 3), t (3,)): the photo's camera placed from the fitted body
+def _head_centred(model: BodyModel, photo: ViewPhoto) -> tuple[np.ndarray, np.ndarray]:
+    """(R (3, 3), t (3,)): the photo's camera placed from its fitted body
     (:func:`placed_camera`), moved sideways so that the body's head (the silhouette's top
     :data:`HEAD_ROWS_SHARE`) is centred on the person's: the placement centres the
     silhouette's horizontal extent, which the hands set, and a swung arm's hand comes
@@ -104,8 +94,8 @@ def _head_centred(model: BodyModel, photo: ViewPhoto, rest: np.ndarray, joints: 
     (5 degrees forward on one arm, 3 back on the other: 7 mm at 3 m)."""
     rotation, translation = placed_camera(model, photo)
     k = np.asarray(photo.intrinsics, float)
-    body = _bent(model, rest, joints, pose_deg[None], np.zeros((1, 4)))
-    rendered = kernels.rasterize(body, model.faces, model.face_parts,
+    rendered = kernels.rasterize(photo.body[None].astype(np.float32), model.faces,
+                                 model.face_parts,
                                  kernels.pinhole_camera(k, rotation, translation),
                                  *photo.mask.shape).numpy()[0] >= 0
     centres = []
@@ -121,17 +111,18 @@ def estimate_arm_swing(model: BodyModel, photo: ViewPhoto, rest: np.ndarray,
     """(4,) degrees: each arm's swing and change of abduction in ``photo`` (the front
     one), the legs' none: the grid point (:data:`SWING_GRID_DEG` x
     :data:`ABDUCTION_GRID_DEG`) whose render of the fitted body (``rest`` (V, 3), its
-    ``joints`` (4, 3), the view's ``pose_deg`` (4,)) through the placed camera
+    ``joints`` (4, 3), the view's ``pose_deg`` (4,): ``photo.body`` so posed) through the
+    placed camera
     (:func:`_head_centred`) differs from the person's mask in the fewest pixels of that
     arm's half of the photo (split at the silhouette's median column); returned as
     (left swing, right swing, left abduction change, right abduction change)."""
     grid = [(a, s) for a in ABDUCTION_GRID_DEG for s in SWING_GRID_DEG]
     poses = np.array([pose_deg + np.r_[a, a, 0.0, 0.0] for a, _ in grid])
     swings = np.array([[s, s, 0.0, 0.0] for _, s in grid])
-    rotation, translation = _head_centred(model, photo, rest, joints, pose_deg)
+    rotation, translation = _head_centred(model, photo)
     k = np.asarray(photo.intrinsics, float)
     height, width = photo.mask.shape
-    labels = kernels.rasterize(_bent(model, rest, joints, poses, swings), model.faces,
+    labels = kernels.rasterize(bent_bodies(model, rest, joints, poses, swings), model.faces,
                                model.face_parts, kernels.pinhole_camera(k, rotation, translation),
                                height, width).numpy()
     wrong = (labels >= 0) != photo.mask[None]
@@ -175,6 +166,6 @@ def bend_readings(model: BodyModel, measurer: Measurer, bodies: Bodies, row: int
                                            shown | {"front": front})
         return [values[key] - truth[key] for key in SCALED]
 
-    rows = [errors()] + [errors(_bent(model, rest, joints, p[None], s[None])[0])
+    rows = [errors()] + [errors(bent_bodies(model, rest, joints, p[None], s[None])[0])
                          for p, s in bends]
     return np.array(rows), estimate

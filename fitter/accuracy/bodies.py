@@ -37,7 +37,8 @@ from bodyfit.fitter.population_sampler import PopulationSampler, PopulationSetti
 from bodyfit.fitter.side_arms import arms_down_angle
 from bodyfit.kernels.body_forward import blend_skinning
 
-__all__ = ["KINDS", "SEXES", "Bodies", "draw_bodies", "flexion_rotations", "pose_bodies"]
+__all__ = ["KINDS", "SEXES", "Bodies", "bent_bodies", "draw_bodies", "flexion_rotations",
+           "pose_bodies"]
 
 KINDS = ("in-space", "out-of-space")
 SEXES = ("female", "male")
@@ -158,6 +159,17 @@ def flexion_rotations(flexion_deg: np.ndarray) -> np.ndarray:
     return rot
 
 
+def bent_bodies(model: BodyModel, rest: np.ndarray, joints: np.ndarray, pose_deg: np.ndarray,
+                flexion_deg: np.ndarray) -> np.ndarray:
+    """(P, V, 3) float32 metres: the rest body (V, 3), its rig joints (4, 3), posed by each
+    row of ``pose_deg`` (P, 4) abduction angles after the same row's ``flexion_deg``
+    (P, 4) bends (:func:`flexion_rotations`), ``POSE_NAMES`` order."""
+    count = len(pose_deg)
+    rotations = abduction_rotations(pose_deg) @ flexion_rotations(flexion_deg)
+    return blend_skinning(model.chain_weights, np.repeat(rest[None], count, 0),
+                          np.repeat(joints[None], count, 0), rotations)
+
+
 def pose_bodies(model: BodyModel, bodies: Bodies, index: int) -> tuple[np.ndarray, np.ndarray]:
     """(front, side) posed vertices (V, 3) float32 of body ``index``: the front photo's
     pose (abduction and flexion), and the side photo's (arms hanging down, no flexion)."""
@@ -165,9 +177,6 @@ def pose_bodies(model: BodyModel, bodies: Bodies, index: int) -> tuple[np.ndarra
     front = bodies.abduction_deg[index].astype(float)
     side = front.copy()
     side[:2] = arms_down_angle(model, rest, joints)
-    flex = flexion_rotations(bodies.flexion_deg[index][None])
-    rotations = np.concatenate([abduction_rotations(front[None]) @ flex,
-                                abduction_rotations(side[None])])
-    posed = blend_skinning(model.chain_weights, np.stack([rest, rest]),
-                           np.stack([joints, joints]), rotations)
+    posed = bent_bodies(model, rest, joints, np.stack([front, side]),
+                        np.stack([bodies.flexion_deg[index], np.zeros(4)]))
     return posed[0], posed[1]

@@ -6,11 +6,10 @@ import pytest
 
 from bodyfit import kernels
 from bodyfit.fitter.accuracy import bend_readings
-from bodyfit.fitter.accuracy.bodies import Bodies, flexion_rotations
-from bodyfit.fitter.body_model import PART_NAMES, abduction_rotations, rest_shape
+from bodyfit.fitter.accuracy.bodies import Bodies, bent_bodies
+from bodyfit.fitter.body_model import PART_NAMES, rest_shape
 from bodyfit.fitter.photo_extents import ViewPhoto, silhouette_axis
 from bodyfit.fitter.pinhole_canvas import Placement
-from bodyfit.kernels.body_forward import blend_skinning
 
 POSE_DEG = np.array([5.0, 5.0, 4.0, 4.0])
 
@@ -20,11 +19,6 @@ def mean_rest(body_model):
     """(rest (V, 3), joints (4, 3)) of the model's mean body, metres."""
     rest, joints = rest_shape(body_model, np.zeros((1, 20)))
     return rest[0].astype(np.float64), joints[0].astype(np.float64)
-
-
-def _posed(body_model, rest, joints, pose_deg, swing_deg) -> np.ndarray:
-    rotations = abduction_rotations(pose_deg[None]) @ flexion_rotations(swing_deg[None])
-    return blend_skinning(body_model.chain_weights, rest[None], joints[None], rotations)[0]
 
 
 def test_a_swing_turns_the_bicep_about_its_arm_and_a_tilt_does_not(body_model, measurer,
@@ -37,7 +31,7 @@ def test_a_swing_turns_the_bicep_about_its_arm_and_a_tilt_does_not(body_model, m
     bodies = Bodies(np.array(["female"]), np.array([False]), rest[None], joints[None],
                     POSE_DEG[None], np.zeros((1, 4)))
     swing, tilt = bend_readings.twist_width_change(body_model, measurer, bodies, 0)
-    body = _posed(body_model, rest, joints, POSE_DEG, np.zeros(4))
+    body = bent_bodies(body_model, rest, joints, POSE_DEG[None], np.zeros(4)[None])[0]
     section = measurer.girth_section(body, "H.L")
     across = measurer.girth_axes(body, "H.L") @ silhouette_axis(measurer, body, "H.L", "front")
     arm = measurer.girth_plane(body, "H.L")[1]
@@ -61,12 +55,13 @@ def test_the_arms_swing_is_read_back_from_a_photo_of_it(body_model, mean_rest):
     estimate then trades swing against abduction.)"""
     rest, joints = mean_rest
     k = np.array([[750.0, 0, 299.5], [0, 750.0, 399.5], [0, 0, 1]])
-    person = _posed(body_model, rest, joints, POSE_DEG, np.array([5.0, -3.0, 0.0, 0.0]))
+    person = bent_bodies(body_model, rest, joints, POSE_DEG[None],
+                         np.array([[5.0, -3.0, 0.0, 0.0]]))[0]
     camera = Placement(3.0, 1.0, 0.0, -person[:, 2].min()).extrinsics("front")
     mask = kernels.rasterize(person[None].astype(np.float32), body_model.faces,
                              body_model.face_parts, kernels.pinhole_camera(k, *camera),
                              800, 600).numpy()[0] >= 0
-    fitted = _posed(body_model, rest, joints, POSE_DEG, np.zeros(4))
+    fitted = bent_bodies(body_model, rest, joints, POSE_DEG[None], np.zeros(4)[None])[0]
     photo = ViewPhoto("front", mask, k, fitted, PART_NAMES)
     estimate = bend_readings.estimate_arm_swing(body_model, photo, rest, joints, POSE_DEG)
     np.testing.assert_allclose(estimate, [5.0, -3.0, 0.0, 0.0])
