@@ -857,6 +857,7 @@ def _rows_of(bodies) -> dict[str, int]:
     """subject id -> its row of the set's ``bodies``, in the set's order."""
     return {subject: row for row, subject in enumerate(subject_ids(len(bodies.sex), bodies.sex))}
 
+
 def bends(args) -> None:
     """How each measurement's signed error follows the front photo's limb bends, which
     the fit's rig cannot make (out-of-space sets: each chain swung forward or back by up
@@ -911,6 +912,8 @@ def bend_readings(args) -> None:
     wanted = list(row_of)[args.skip:args.first]
     holders = _record_holders([_run_folder(folder, name) for name in args.names], wanted)
     subjects = [s for s in wanted if s in holders]
+    if len(subjects) < 2:
+        sys.exit(f"{folder}: fewer than 2 subjects fitted by {', '.join(args.names)}")
     twists, errors, estimates = [], [], []
     for subject in subjects:
         row = row_of[subject]

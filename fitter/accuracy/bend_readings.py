@@ -28,14 +28,14 @@ from pathlib import Path
 import numpy as np
 
 from bodyfit import kernels
-from bodyfit.fitter.accuracy.bodies import Bodies, bent_bodies, flexion_rotations
+from bodyfit.fitter.accuracy.bodies import (Bodies, bent_bodies, flexion_rotations,
+                                            turned_bodies)
 from bodyfit.fitter.accuracy.fit_photos import FitPhotos, answer_pose
-from bodyfit.fitter.body_model import BodyModel, abduction_rotations, rest_shape
+from bodyfit.fitter.body_model import BodyModel, rest_shape
 from bodyfit.fitter.fit import fitted_bodies, view_photos
 from bodyfit.fitter.measurements import Measurer
 from bodyfit.fitter.photo_extents import (SCALED, ViewPhoto, photo_scaled_measurements,
                                           placed_camera, silhouette_axis)
-from bodyfit.kernels.body_forward import blend_skinning
 
 __all__ = ["VARIANTS", "SWING_GRID_DEG", "ABDUCTION_GRID_DEG", "HEAD_ROWS_SHARE",
            "twist_width_change", "estimate_arm_swing", "bend_readings"]
@@ -71,14 +71,13 @@ def twist_width_change(model: BodyModel, measurer: Measurer, bodies: Bodies, row
     across /= np.linalg.norm(across)
     if (_axis_rotation(across, 1.0) @ arm)[1] > 0:  # forward is -y
         across = -across
-    pose = bodies.abduction_deg[row][None].astype(float)
+    poses = np.repeat(bodies.abduction_deg[row][None].astype(float), 2, axis=0)
     changes = []
     for turn_of in (flexion_rotations, lambda d: _axis_rotation(across, d)):
+        turns = np.array([[turn_of(np.float64(d))] + [np.eye(3)] * 3
+                          for d in (-degrees, degrees)])
         widths = []
-        for d in (-degrees, degrees):
-            turn = np.stack([turn_of(np.float64(d))] + [np.eye(3)] * 3)
-            body = blend_skinning(model.chain_weights, rest[None], joints[None],
-                                  abduction_rotations(pose) @ turn[None])[0]
+        for body in turned_bodies(model, rest, joints, poses, turns):
             section = measurer.girth_section(body, "H.L") @ measurer.girth_axes(body, "H.L")
             widths.append(np.ptp(section @ silhouette_axis(measurer, body, "H.L", "front")))
         changes.append(100.0 * (widths[1] - widths[0]) / (2 * degrees) / np.mean(widths))
@@ -166,6 +165,6 @@ def bend_readings(model: BodyModel, measurer: Measurer, bodies: Bodies, row: int
                                            shown | {"front": front})
         return [values[key] - truth[key] for key in SCALED]
 
-    rows = [errors()] + [errors(bent_bodies(model, rest, joints, p[None], s[None])[0])
-                         for p, s in bends]
+    bent = bent_bodies(model, rest, joints, *(np.array(a) for a in zip(*bends)))
+    rows = [errors()] + [errors(body) for body in bent]
     return np.array(rows), estimate

@@ -38,7 +38,7 @@ from bodyfit.fitter.side_arms import arms_down_angle
 from bodyfit.kernels.body_forward import blend_skinning
 
 __all__ = ["KINDS", "SEXES", "Bodies", "bent_bodies", "draw_bodies", "flexion_rotations",
-           "pose_bodies"]
+           "pose_bodies", "turned_bodies"]
 
 KINDS = ("in-space", "out-of-space")
 SEXES = ("female", "male")
@@ -159,15 +159,22 @@ def flexion_rotations(flexion_deg: np.ndarray) -> np.ndarray:
     return rot
 
 
+def turned_bodies(model: BodyModel, rest: np.ndarray, joints: np.ndarray,
+                  pose_deg: np.ndarray, turns: np.ndarray) -> np.ndarray:
+    """(P, V, 3) float32 metres: the rest body (V, 3), its rig joints (4, 3), posed by each
+    row of ``pose_deg`` (P, 4) abduction angles after the same row's ``turns``
+    (P, 4, 3, 3) rotations of each chain about its joint, ``POSE_NAMES`` order."""
+    count = len(pose_deg)
+    return blend_skinning(model.chain_weights, np.repeat(rest[None], count, 0),
+                          np.repeat(joints[None], count, 0),
+                          abduction_rotations(pose_deg) @ turns)
+
+
 def bent_bodies(model: BodyModel, rest: np.ndarray, joints: np.ndarray, pose_deg: np.ndarray,
                 flexion_deg: np.ndarray) -> np.ndarray:
-    """(P, V, 3) float32 metres: the rest body (V, 3), its rig joints (4, 3), posed by each
-    row of ``pose_deg`` (P, 4) abduction angles after the same row's ``flexion_deg``
-    (P, 4) bends (:func:`flexion_rotations`), ``POSE_NAMES`` order."""
-    count = len(pose_deg)
-    rotations = abduction_rotations(pose_deg) @ flexion_rotations(flexion_deg)
-    return blend_skinning(model.chain_weights, np.repeat(rest[None], count, 0),
-                          np.repeat(joints[None], count, 0), rotations)
+    """:func:`turned_bodies` turned by the (P, 4) ``flexion_deg`` bends
+    (:func:`flexion_rotations`)."""
+    return turned_bodies(model, rest, joints, pose_deg, flexion_rotations(flexion_deg))
 
 
 def pose_bodies(model: BodyModel, bodies: Bodies, index: int) -> tuple[np.ndarray, np.ndarray]:
