@@ -25,6 +25,7 @@ import dataclasses
 import json
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from bodyfit import kernels
@@ -51,11 +52,8 @@ _ARMS, _LEGS = [0, 1], [2, 3]  # POSE_NAMES columns
 
 
 def _axis_rotation(axis: np.ndarray, degrees: float) -> np.ndarray:
-    """(3, 3) the rotation by ``degrees`` about the unit ``axis`` (3,) (Rodrigues)."""
-    x, y, z = axis
-    cross = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    phi = np.deg2rad(degrees)
-    return np.eye(3) + np.sin(phi) * cross + (1.0 - np.cos(phi)) * cross @ cross
+    """(3, 3) the rotation by ``degrees`` about the unit ``axis`` (3,) (OpenCV's Rodrigues)."""
+    return cv2.Rodrigues(np.deg2rad(degrees) * np.asarray(axis, np.float64))[0]
 
 
 def twist_width_change(model: BodyModel, measurer: Measurer, bodies: Bodies, row: int,
@@ -150,12 +148,13 @@ def bend_readings(model: BodyModel, measurer: Measurer, bodies: Bodies, row: int
     rest, joints = (a[0] for a in rest_shape(model, betas[None]))
     front_pose = photos.views["front"].view_pose(pose[None])[0]
     estimate = estimate_arm_swing(model, shown["front"], rest, joints, front_pose)
-    bends = []
-    for chains in (_ARMS, _LEGS, _ARMS + _LEGS):
-        swing = np.zeros(4)
-        swing[chains] = bodies.flexion_deg[row][chains]
-        bends.append((front_pose, swing))
-    bends.append((front_pose + np.r_[estimate[2:], 0.0, 0.0], np.r_[estimate[:2], 0.0, 0.0]))
+    # the truth's bends of the arms, the legs, both; then the estimate's swing and abduction
+    swings = np.zeros((4, 4))
+    for bend, chains in enumerate((_ARMS, _LEGS, _ARMS + _LEGS)):
+        swings[bend, chains] = bodies.flexion_deg[row][chains]
+    swings[3, :2] = estimate[:2]
+    poses = np.repeat(np.asarray(front_pose, np.float64)[None], 4, axis=0)
+    poses[3, :2] += estimate[2:]
     truth = json.loads((set_folder / subject / "truth.json").read_text())["measurements"]
 
     def errors(front_body=None) -> list[float]:
@@ -165,6 +164,5 @@ def bend_readings(model: BodyModel, measurer: Measurer, bodies: Bodies, row: int
                                            shown | {"front": front})
         return [values[key] - truth[key] for key in SCALED]
 
-    bent = bent_bodies(model, rest, joints, *(np.array(a) for a in zip(*bends)))
-    rows = [errors()] + [errors(body) for body in bent]
+    rows = [errors()] + [errors(body) for body in bent_bodies(model, rest, joints, poses, swings)]
     return np.array(rows), estimate
