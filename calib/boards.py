@@ -29,7 +29,7 @@ import cv2
 import numpy as np
 from scipy.spatial.distance import pdist
 
-from bodyfit.calib.errors import UserError
+from bodyfit.common.errors import UserError
 
 __all__ = [
     "BOARD_KINDS",

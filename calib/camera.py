@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from bodyfit.calib.boards import BoardSpec
-from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import read_json_file
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import read_json_file
 
 __all__ = ["CAMERA_FORMAT", "DIST_LENGTHS", "CalibrationInput", "Camera", "camera_fields", "load_camera"]
 

@@ -14,10 +14,10 @@ import cv2
 
 from bodyfit.calib.boards import BoardDetector, BoardSpec
 from bodyfit.calib.capture import Calibration, CaptureSettings, calibrate, collect_views
-from bodyfit.calib.command_line import bodyfit_version
 from bodyfit.calib.coverage import coverage_fraction, coverage_picture
-from bodyfit.calib.files import check_writable_dir, file_sha256, write_atomic
 from bodyfit.calib.images import write_image
+from bodyfit.common.command_line import bodyfit_version
+from bodyfit.common.files import check_writable_dir, file_sha256, write_atomic
 
 __all__ = ["capture_camera"]
 

@@ -1,6 +1,6 @@
 """Camera calibration from board photos and videos: views, the solve, outlier rejection.
 
-Every input image becomes a :class:`View` with a status: ``used``, or rejected with a
+Every input image becomes a :class:`BoardView` with a status: ``used``, or rejected with a
 reason -- no board found, too blurry (10-90 % edge rise over the board wider than
 ``max_edge_rise_px``), the same board position as an earlier video frame, or an outlier
 (its RMS reprojection error above ``outlier_factor`` times the median view's and above
@@ -27,16 +27,16 @@ from tqdm import tqdm
 from bodyfit.calib.blur import edge_rise_px
 from bodyfit.calib.boards import BoardDetection, BoardDetector, BoardSpec
 from bodyfit.calib.camera import Camera, camera_fields
-from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import frame_name, is_video, read_frames
+from bodyfit.common.errors import UserError
 
 __all__ = [
     "DISTORTION_MODELS",
     "INTRINSIC_NAMES",
     "Calibration",
     "CaptureSettings",
-    "View",
-    "ViewStatus",
+    "BoardView",
+    "BoardViewStatus",
     "calibrate",
     "collect_views",
     "describe_views",
@@ -97,7 +97,7 @@ class CaptureSettings:
             raise UserError(f"--video-frames must be at least 1, got {self.video_max_frames}")
 
 
-class ViewStatus(str, enum.Enum):
+class BoardViewStatus(str, enum.Enum):
     """What became of a view."""
 
     USED = "used"
@@ -108,7 +108,7 @@ class ViewStatus(str, enum.Enum):
 
 
 @dataclass(frozen=True)
-class View:
+class BoardView:
     """One photo or video frame offered to the calibration.
 
     Attributes:
@@ -123,7 +123,7 @@ class View:
 
     source: str
     frame_index: int | None
-    status: ViewStatus
+    status: BoardViewStatus
     detection: BoardDetection | None = None
     edge_rise_px: float | None = None
     error_px: float | None = None
@@ -166,7 +166,7 @@ def _moved_px(a: BoardDetection, b: BoardDetection) -> float:
 
 def collect_views(
     paths: Iterable[str], detector: BoardDetector, settings: CaptureSettings
-) -> tuple[list[View], tuple[int, int]]:
+) -> tuple[list[BoardView], tuple[int, int]]:
     """Find the board in every input image and sort out the views to use (with a
     progress bar on stderr when it is a terminal).
 
@@ -175,7 +175,7 @@ def collect_views(
         outlier rejection in :func:`calibrate`), and (width, height) of the images.
     """
     paths = list(paths)
-    views: list[View] = []
+    views: list[BoardView] = []
     image_size: tuple[int, int] | None = None
     frames = tqdm(read_frames(paths, settings.video_max_frames), desc="finding the board",
                   unit="view", disable=None, leave=False,
@@ -185,21 +185,21 @@ def collect_views(
         gray = cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)
         detection = detector.detect(gray)
         if detection is None:
-            views.append(View(source, frame_index, ViewStatus.NO_BOARD))
+            views.append(BoardView(source, frame_index, BoardViewStatus.NO_BOARD))
             log.info("%s: no board", views[-1].name)
             continue
         rise = edge_rise_px(gray, _board_region(gray.shape, detection))
-        status = ViewStatus.USED
+        status = BoardViewStatus.USED
         if rise > settings.max_edge_rise_px:
-            status = ViewStatus.BLURRY
+            status = BoardViewStatus.BLURRY
         elif frame_index is not None and any(
-            view.status is ViewStatus.USED
+            view.status is BoardViewStatus.USED
             and view.source == source
             and _moved_px(view.detection, detection) < settings.video_min_motion_px
             for view in views
         ):
-            status = ViewStatus.DUPLICATE
-        views.append(View(source, frame_index, status, detection, rise))
+            status = BoardViewStatus.DUPLICATE
+        views.append(BoardView(source, frame_index, status, detection, rise))
         log.info(
             "%s: %s (%d corners, edge rise %.2f px)", views[-1].name, status.value, len(detection.corner_ids), rise
         )
@@ -224,16 +224,16 @@ class Calibration:
     camera: Camera
     std: dict[str, float]
     rms_px: float
-    views: tuple[View, ...]
+    views: tuple[BoardView, ...]
     settings: CaptureSettings
 
     @property
-    def used_views(self) -> list[View]:
+    def used_views(self) -> list[BoardView]:
         """The views the final solve used."""
-        return [view for view in self.views if view.status is ViewStatus.USED]
+        return [view for view in self.views if view.status is BoardViewStatus.USED]
 
     @property
-    def worst_view(self) -> View:
+    def worst_view(self) -> BoardView:
         """The used view with the largest reprojection error."""
         return max(self.used_views, key=lambda view: view.error_px)
 
@@ -249,7 +249,7 @@ class Calibration:
 
 
 def _solve(
-    views: list[View], image_size: tuple[int, int], flags: int
+    views: list[BoardView], image_size: tuple[int, int], flags: int
 ) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(rms_px, K (3, 3), dist (n,), intrinsic std (18,), per-view RMS (views,)) from OpenCV."""
     object_points = [view.detection.object_points for view in views]
@@ -273,7 +273,7 @@ def _solve(
 
 
 def calibrate(
-    views: list[View], image_size: tuple[int, int], settings: CaptureSettings, board: BoardSpec | None = None
+    views: list[BoardView], image_size: tuple[int, int], settings: CaptureSettings, board: BoardSpec | None = None
 ) -> Calibration:
     """Solve the camera from the ``used`` views, rejecting outliers one at a time.
 
@@ -295,7 +295,7 @@ def calibrate(
             "corners, a charuco board squares) and that the whole board is in the picture"
         )
     while True:
-        active = [index for index, view in enumerate(views) if view.status is ViewStatus.USED]
+        active = [index for index, view in enumerate(views) if view.status is BoardViewStatus.USED]
         if len(active) < settings.min_views:
             raise UserError(
                 f"only {len(active)} usable view{'s' if len(active) != 1 else ''}, "
@@ -309,7 +309,7 @@ def calibrate(
         worst = int(np.argmax(errors))
         if errors[worst] <= threshold:
             break
-        views[active[worst]] = dataclasses.replace(views[active[worst]], status=ViewStatus.OUTLIER)
+        views[active[worst]] = dataclasses.replace(views[active[worst]], status=BoardViewStatus.OUTLIER)
         log.info("%s: outlier (%.3f px > %.3f px), solving again", views[active[worst]].name, errors[worst], threshold)
     names = ("fx", "fy", "cx", "cy") + estimated
     deviations = {name: float(std[INTRINSIC_NAMES.index(name)]) for name in names}
@@ -317,12 +317,12 @@ def calibrate(
     return Calibration(camera, deviations, float(rms), tuple(views), settings)
 
 
-def describe_views(views: Iterable[View]) -> str:
+def describe_views(views: Iterable[BoardView]) -> str:
     """``12 used, 3 rejected (1 no board, 2 too blurry)`` for summaries."""
     views = list(views)
-    used = sum(view.status is ViewStatus.USED for view in views)
+    used = sum(view.status is BoardViewStatus.USED for view in views)
     rejected = {
-        status: sum(view.status is status for view in views) for status in ViewStatus if status is not ViewStatus.USED
+        status: sum(view.status is status for view in views) for status in BoardViewStatus if status is not BoardViewStatus.USED
     }
     detail = ", ".join(f"{n} {status.value}" for status, n in rejected.items() if n)
     return f"{used} used, {len(views) - used} rejected" + (f" ({detail})" if detail else "")

@@ -25,9 +25,9 @@ import numpy as np
 
 from bodyfit.calib.boards import BoardDetection, BoardDetector
 from bodyfit.calib.camera import Camera
-from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import file_sha256
 from bodyfit.calib.images import frame_name, read_frames
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import file_sha256
 
 __all__ = ["CheckedView", "check_calibration", "is_calibration_input", "rms_px"]
 

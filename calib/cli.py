@@ -18,14 +18,15 @@ import numpy as np
 from bodyfit.calib.boards import BoardDetector, BoardSpec, parse_board, render_board
 from bodyfit.calib.camera import load_camera
 from bodyfit.calib.camera_capture import capture_camera
-from bodyfit.calib.capture import DISTORTION_MODELS, INTRINSIC_NAMES, CaptureSettings, describe_views
+from bodyfit.calib.capture import (DISTORTION_MODELS, INTRINSIC_NAMES, CaptureSettings,
+                                   describe_views)
 from bodyfit.calib.check import CheckedView, check_calibration, rms_px
-from bodyfit.calib.command_line import OneLineArgumentParser, bodyfit_version
-from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import check_writable_dir, write_atomic
 from bodyfit.calib.images import encode_image, read_photo, to_upright, write_image
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.calib.undistort import undistort_image
+from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import check_writable_dir, write_atomic
 
 __all__ = ["main"]
 

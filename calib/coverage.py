@@ -14,7 +14,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from bodyfit.calib.capture import View, ViewStatus
+from bodyfit.calib.capture import BoardView, BoardViewStatus
 
 __all__ = ["COVERAGE_GRID", "coverage_fraction", "coverage_picture"]
 
@@ -26,8 +26,8 @@ _LEGEND_LINE_PX = 24
 _LEGEND_COLUMNS = 4  # view entries per legend line
 
 
-def _used_points(views: list[View]) -> list[np.ndarray]:
-    return [view.detection.image_points for view in views if view.status is ViewStatus.USED]
+def _used_points(views: list[BoardView]) -> list[np.ndarray]:
+    return [view.detection.image_points for view in views if view.status is BoardViewStatus.USED]
 
 
 def _occupied_cells(points: list[np.ndarray], image_size_px: tuple[int, int]) -> np.ndarray:
@@ -43,7 +43,7 @@ def _occupied_cells(points: list[np.ndarray], image_size_px: tuple[int, int]) ->
     return occupied
 
 
-def coverage_fraction(views: list[View], image_size_px: tuple[int, int]) -> float:
+def coverage_fraction(views: list[BoardView], image_size_px: tuple[int, int]) -> float:
     """Share (0..1) of the frame's grid cells that hold a corner of a used view."""
     return float(_occupied_cells(_used_points(views), image_size_px).mean())
 
@@ -123,7 +123,7 @@ def _legend(names: list[str], occupied: np.ndarray, width: int) -> np.ndarray:
     return panel
 
 
-def coverage_picture(views: list[View], image_size_px: tuple[int, int]) -> np.ndarray:
+def coverage_picture(views: list[BoardView], image_size_px: tuple[int, int]) -> np.ndarray:
     """(H', 1200, 3) uint8 BGR picture of the frame with the used corners, and a legend below.
 
     Each used view's corners are dots joined by their convex hull, one colour per view;
@@ -134,7 +134,7 @@ def coverage_picture(views: list[View], image_size_px: tuple[int, int]) -> np.nd
     width, height = image_size_px
     scale = _PICTURE_WIDTH_PX / width
     size = (_PICTURE_WIDTH_PX, max(1, round(height * scale)))
-    used = [view for view in views if view.status is ViewStatus.USED]
+    used = [view for view in views if view.status is BoardViewStatus.USED]
     points = _used_points(used)
     occupied = _occupied_cells(points, image_size_px)
     frame = _frame_picture(points, occupied, size, scale)

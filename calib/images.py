@@ -23,8 +23,8 @@ import cv2
 import numpy as np
 
 from bodyfit.calib.blur import edge_rise_px
-from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import check_input_file, write_atomic
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import check_input_file, write_atomic
 
 __all__ = [
     "VIDEO_SUFFIXES",

@@ -58,9 +58,9 @@ import torch
 from kornia.morphology import closing, opening
 
 from bodyfit.calib.camera import Camera
-from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import read_image_file, read_photo, to_upright
 from bodyfit.calib.undistort import undistort_image
+from bodyfit.common.errors import UserError
 
 __all__ = ["SilhouetteSettings", "extract_silhouette", "load_mask", "photo_silhouette"]
 

@@ -4,7 +4,7 @@ The entry point for a fitter (one person, many generations)::
 
     from bodyfit import kernels
 
-    model = kernels.ModelArrays.from_body_model(body_model, num_betas=20, device="cpu")
+    model = kernels.ModelArrays.from_body_model(body_model, num_components=20, device="cpu")
     front = kernels.prepare_view_target("front", front_mask, front_camera, mm_per_px)
     side = kernels.prepare_view_target("side", side_mask, side_camera, mm_per_px,
                                        visible_parts=kernels.SIDE_VIEW_PARTS)

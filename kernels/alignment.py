@@ -18,7 +18,7 @@ This is exact for a silhouette that is a rotated and shifted copy of the other, 
 one pass over per-row sums per candidate, and needs no iterations (ICP needs a
 nearest-neighbour pass per iteration). With ``align_rotation`` off only the translation is
 used (for photos known to be level). The CPU ICP of the paper, for overlays, is
-:mod:`bodyfit.fitter.contour`.
+:mod:`bodyfit.fitter.fit.contour`.
 
 Transforms map person pixels (column, row) to candidate pixels: x = R (z - c_person) +
 c_candidate, stored as homogeneous (3, 3) matrices.

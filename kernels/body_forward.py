@@ -1,7 +1,7 @@
 """The body model's forward map in NumPy (the paper's Eq. 1-3): shape blend, then skinning.
 
 The reference the Warp skinning kernels are checked against, and the host-side forward of
-the fitter (:mod:`bodyfit.fitter.body_model` re-exports it). Typed on
+the fitter (:mod:`bodyfit.fitter.model.body_model` re-exports it). Typed on
 :class:`bodyfit.kernels.skinning.SkinnableModel`'s attributes; no Warp, so importing it
 initialises nothing.
 """

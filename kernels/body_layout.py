@@ -1,7 +1,7 @@
 """The body's layout, shared by every package: part labels and pose degrees of freedom.
 
 The kernels are the bottom layer, so the names both they and the body model
-(:mod:`bodyfit.fitter.body_model`, which re-exports them) index arrays by live here.
+(:mod:`bodyfit.fitter.model.body_model`, which re-exports them) index arrays by live here.
 Plain constants, no Warp: importing this module initialises nothing.
 """
 

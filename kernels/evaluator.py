@@ -1,6 +1,6 @@
 """Scoring whole populations against the person's views: the kernels' entry point.
 
-    model = ModelArrays.from_body_model(load_model(), num_betas=20, device="cpu")
+    model = ModelArrays.from_body_model(load_model(), num_components=20, device="cpu")
     views = [prepare_view_target("front", front_mask, front_camera, mm_per_px), ...]
     evaluator = PopulationEvaluator(model, views, CostSettings())
     costs, part_costs = evaluator.evaluate(betas, pose_deg)     # every generation
@@ -231,7 +231,7 @@ class PopulationEvaluator:
             ValueError: wrong shapes or dtypes.
         """
         dev = self.model.device
-        dims = {"K": self.model.num_betas}
+        dims = {"K": self.model.num_components}
         betas = device_array("betas", betas, ("P", "K"), dims, "float", wp.float32, dev)
         pose_deg = device_array("pose_deg", pose_deg, ("P", len(POSE_NAMES)), dims, "float",
                                 wp.float32, dev)

@@ -1,7 +1,7 @@
 """The body model on a device, and skinning: (P, K) betas + (P, 4) pose -> (P, V, 3) vertices.
 
 The same maths as the body model's NumPy forward (:func:`bodyfit.kernels.body_forward.forward`,
-re-exported as ``bodyfit.fitter.body_model.forward``; the paper's Eq. 1-3):
+re-exported as ``bodyfit.fitter.model.body_model.forward``; the paper's Eq. 1-3):
 
     rest_i  = mean_i + sum_k betas[k] * vertex_dirs[k, i]                 (shape blend)
     joint_c = mean_joint_c + sum_k betas[k] * joint_dirs[k, c]
@@ -31,7 +31,7 @@ NUM_CHAINS = len(POSE_NAMES)
 class SkinnableModel(Protocol):
     """What the kernels read from a body model (duck-typed; the kernels import no model).
 
-    :class:`bodyfit.fitter.body_model.BodyModel` is one. V vertices, F faces, C stored
+    :class:`bodyfit.fitter.model.body_model.BodyModel` is one. V vertices, F faces, C stored
     shape components, 4 rig chains (``POSE_NAMES`` order).
 
     Attributes:
@@ -52,9 +52,9 @@ class SkinnableModel(Protocol):
     num_vertices: int
     num_components: int
 
-    def shape_directions(self, num_betas: int) -> tuple[np.ndarray, np.ndarray]:
+    def shape_directions(self, num_components: int) -> tuple[np.ndarray, np.ndarray]:
         """(K, V, 3) vertex and (K, 4, 3) joint directions scaled by their standard
-        deviation (metres per sigma), K = ``num_betas`` <= C."""
+        deviation (metres per sigma), K = ``num_components`` <= C."""
 
 
 @wp.struct
@@ -140,7 +140,7 @@ class ModelArrays:
         space: the shape space and rig (see :class:`ShapeSpace`).
         faces: (F, 3) int32 triangles, counter-clockwise seen from outside (NumPy, host).
         face_parts: (F,) int8 index into ``PART_NAMES`` (NumPy, host).
-        num_betas: K.
+        num_components: K.
         num_vertices: V.
         device: the Warp device holding ``space``.
     """
@@ -148,30 +148,30 @@ class ModelArrays:
     space: ShapeSpace
     faces: np.ndarray
     face_parts: np.ndarray
-    num_betas: int
+    num_components: int
     num_vertices: int
     device: wp.Device
 
     @classmethod
-    def from_body_model(cls, model: SkinnableModel, num_betas: int = 20,
+    def from_body_model(cls, model: SkinnableModel, num_components: int = 20,
                         device: str = "cpu") -> "ModelArrays":
-        """Copy the model's first ``num_betas`` shape directions and its rig to ``device``.
+        """Copy the model's first ``num_components`` shape directions and its rig to ``device``.
 
         Args:
             model: any object with the attributes of :class:`SkinnableModel` (a
-                :class:`bodyfit.fitter.body_model.BodyModel`).
+                :class:`bodyfit.fitter.model.body_model.BodyModel`).
 
         Raises:
-            ValueError: the model stores fewer than ``num_betas`` components, its part
+            ValueError: the model stores fewer than ``num_components`` components, its part
                 labels exceed ``PART_NAMES``, or the device is unavailable.
         """
         dev = resolve_device(device)
-        if not 1 <= num_betas <= model.num_components:
+        if not 1 <= num_components <= model.num_components:
             raise ValueError(f"the body model stores {model.num_components} shape components; "
-                             f"asked for {num_betas}")
+                             f"asked for {num_components}")
         if model.face_parts.max() >= len(PART_NAMES):
             raise ValueError("the model's part labels exceed PART_NAMES")
-        vertex_dirs, joint_dirs = model.shape_directions(num_betas)
+        vertex_dirs, joint_dirs = model.shape_directions(num_components)
         space = ShapeSpace()
         space.mean_vertices = wp.array(model.mean_vertices, dtype=wp.vec3, device=dev)
         space.vertex_dirs = wp.array(np.ascontiguousarray(vertex_dirs.transpose(1, 0, 2)),
@@ -181,7 +181,7 @@ class ModelArrays:
                                     dtype=wp.vec3, device=dev)
         space.chain_weights = wp.array(model.chain_weights, dtype=wp.float32, device=dev)
         space.chain_sides = wp.array(POSE_SIDES.astype(np.float32), dtype=wp.float32, device=dev)
-        return cls(space, model.faces.astype(np.int32), model.face_parts, num_betas,
+        return cls(space, model.faces.astype(np.int32), model.face_parts, num_components,
                    model.num_vertices, dev)
 
 
@@ -225,7 +225,7 @@ def skin(model: ModelArrays, betas, pose_deg) -> wp.array:
     Raises:
         ValueError: wrong shapes or dtypes.
     """
-    dims = {"K": model.num_betas}
+    dims = {"K": model.num_components}
     betas = device_array("betas", betas, ("P", "K"), dims, "float", wp.float32, model.device)
     pose_deg = device_array("pose_deg", pose_deg, ("P", NUM_CHAINS), dims, "float", wp.float32,
                             model.device)

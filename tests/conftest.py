@@ -7,22 +7,22 @@ import pytest
 def body_model():
     """The default body model shipped in the package (a user-built model in the cache,
     if any, is not used, so the tests see what every install sees)."""
-    from bodyfit.fitter.body_model import BodyModel
-    from bodyfit.fitter.model_cache import shipped_model_path
+    from bodyfit.fitter.model.body_model import BodyModel
+    from bodyfit.fitter.model.cache import shipped_model_path
 
     return BodyModel.load(shipped_model_path())
 
 
 @pytest.fixture(scope="session")
 def anny_source():
-    from bodyfit.fitter.anny_source import AnnySource
+    from bodyfit.fitter.model_build.anny_source import AnnySource
 
     return AnnySource()
 
 
 @pytest.fixture(scope="session")
 def measurer(body_model):
-    from bodyfit.fitter.measurements import Measurer
+    from bodyfit.fitter.measure.measurements import Measurer
 
     return Measurer.from_model(body_model)
 

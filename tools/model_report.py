@@ -2,9 +2,9 @@
 
 Reports, for the cached body model (built first if missing):
 - build settings and time, file size, load time;
-- the population's measurement statistics next to ANSUR II's, per sex, and the main
+- the sample's measurement statistics next to ANSUR II's, per sex, and the main
   correlations;
-- the PCA space's reconstruction error on held-out bodies of the same population (drawn
+- the PCA space's reconstruction error on held-out bodies drawn as the sample was (drawn
   with another seed) for K = 10, 20, 40, 60 components: vertex error (mean and 95th
   percentile) and the error of all 16 measurements;
 - a picture of the part labels, front and side (docs/model_parts.png).
@@ -23,15 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
-from bodyfit.fitter.anny_source import AnnySource
-from bodyfit.fitter.body_model import BodyModel, project_shape, rest_shape
-from bodyfit.fitter.measurements import IMPORTANT, MEASUREMENTS, Measurer
-from bodyfit.fitter.model_cache import active_model_path, load_model
 from bodyfit.calib.images import write_image
-from bodyfit.fitter.outputs import write_text
-from bodyfit.fitter.model_build import ModelBuildSettings
-from bodyfit.fitter.population_sampler import SEXES, PopulationSampler, ReferenceStats
-from bodyfit.fitter.render import parts_legend, render_parts
+from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS, Measurer
+from bodyfit.fitter.model.body_model import BodyModel, project_shape, rest_shape
+from bodyfit.fitter.model.cache import active_model_path, load_model
+from bodyfit.fitter.model_build.anny_source import AnnySource
+from bodyfit.fitter.model_build.body_sample import SEXES, BodySampler, ReferenceStats
+from bodyfit.fitter.model_build.builder import ModelBuildSettings
+from bodyfit.fitter.output.render import parts_legend, render_parts
+from bodyfit.fitter.output.result_files import write_text
 
 KEYS = list(MEASUREMENTS)
 REALISM_KEYS = ("O", "D", "E", "F", "L", "P", "K")  # the issue's list
@@ -42,17 +42,17 @@ COMPONENT_COUNTS = (10, 20, 40, 60)
 
 def realism_section(model: BodyModel) -> list[str]:
     ref = ReferenceStats.load()
-    lines = ["## The population next to ANSUR II", "",
-             f"The {len(model.population_sex)} bodies the shape space was learned from "
+    lines = ["## The sample next to ANSUR II", "",
+             f"The {len(model.sample_sex)} bodies the shape space was learned from "
              "(half men, half women), measured with bodyfit's definitions "
-             f"(`bodyfit.fitter.measurements`), against ANSUR II ({ref.n['male']:,} men, "
+             f"(`bodyfit.fitter.measure.measurements`), against ANSUR II ({ref.n['male']:,} men, "
              f"{ref.n['female']:,} women). "
-             "Mean (SD) in mm; ratio = population / ANSUR. The issue's bar: ratios within "
+             "Mean (SD) in mm; ratio = sample / ANSUR. The issue's bar: ratios within "
              "0.90-1.10 for the measurements marked *.", ""]
     for sex in SEXES:
-        pop = model.population_measurements[model.population_sex == SEXES.index(sex)]
+        pop = model.sample_measurements[model.sample_sex == SEXES.index(sex)]
         lines += [f"### {sex} ({len(pop)} bodies)", "",
-                  "| key | measurement | population | ANSUR II | ratio mean | ratio SD |",
+                  "| key | measurement | sample | ANSUR II | ratio mean | ratio SD |",
                   "|---|---|---|---|---|---|"]
         for key in KEYS:
             col = pop[:, KEYS.index(key)]
@@ -65,7 +65,7 @@ def realism_section(model: BodyModel) -> list[str]:
             else:
                 lines.append(f"| {key} | {name} | {col.mean():.0f} ({col.std():.0f}) | — | — | — |")
         corr = np.corrcoef(pop, rowvar=False)
-        lines += ["", "| correlation | population | ANSUR II |", "|---|---|---|"]
+        lines += ["", "| correlation | sample | ANSUR II |", "|---|---|---|"]
         for a, b in CORRELATION_PAIRS:
             want = ref.correlation[sex][ref.keys.index(a), ref.keys.index(b)]
             lines.append(f"| {MEASUREMENTS[a][1]} ~ {MEASUREMENTS[b][1]} | "
@@ -80,7 +80,7 @@ def realism_section(model: BodyModel) -> list[str]:
 def reconstruction_section(model: BodyModel, held_out, measurer: Measurer) -> list[str]:
     truth = held_out.measurements
     lines = ["## Reconstruction of held-out bodies", "",
-             f"{len(held_out.sex)} bodies drawn like the population but with another seed "
+             f"{len(held_out.sex)} bodies drawn like the sample but with another seed "
              "(never seen by the PCA), projected orthogonally onto the first K components "
              "(the best any fit in a K-dimensional space can do). Vertex error: distance "
              "between corresponding vertices, mm, over all vertices of all bodies. "
@@ -126,8 +126,8 @@ def main() -> None:
     measurer = Measurer.from_model(model)
     t0 = time.perf_counter()
     half = args.held_out // 2
-    held_out = PopulationSampler(AnnySource(), measurer,
-                                 ModelBuildSettings.of(model).population).sample(
+    held_out = BodySampler(AnnySource(), measurer,
+                                 ModelBuildSettings.of(model).sampling).sample(
         {"male": half, "female": half}, seed=args.seed)
     held_out_s = time.perf_counter() - t0
 
@@ -138,16 +138,16 @@ def main() -> None:
              f"({platform.machine()}, {platform.python_version()}, "
              f"anny {meta['anny_version']}). The model described is the one `fitter` uses "
              "(`fitter model info` names it); the shipped default is built by `fitter model build -o "
-             "fitter/data/body_model.npz` (see `fitter/model_build.py`); this file by "
+             "fitter/data/body_model.npz` (see `fitter/model_build/builder.py`); this file by "
              "`tools/model_report.py`.", "",
              "## Build", "",
              f"- settings: {meta['settings']}",
              f"- {model.num_vertices} vertices, {len(model.faces)} triangles, "
              f"{model.num_components} components stored (20 used by default), "
-             f"explaining {meta['explained_variance']:.6f} of the population's variance",
+             f"explaining {meta['explained_variance']:.6f} of the sample's variance",
              f"- build time: {meta['timings_s']['total']:.0f} s on the build machine "
-             f"(setup {meta['timings_s']['setup']:.0f} s, population "
-             f"{meta['timings_s']['population']:.0f} s, PCA {meta['timings_s']['pca']:.0f} s), "
+             f"(setup {meta['timings_s']['setup']:.0f} s, sample "
+             f"{meta['timings_s']['sample']:.0f} s, PCA {meta['timings_s']['pca']:.0f} s), "
              "plus about a minute the first time Anny builds its own data cache (1.1 GB)",
              f"- file: `{path.name}`, {path.stat().st_size / 1e6:.1f} MB (compressed .npz)",
              f"- load time: {np.median(loads) * 1000:.0f} ms (median of 5)",
@@ -165,7 +165,7 @@ def main() -> None:
     write_image(args.docs / "model_parts.png", np.concatenate(views + [parts_legend(700)], axis=1))
     lines += ["## Part labels", "",
               "The mean body, front and side, coloured by its ten parts (Table 2's nine and the neck); "
-              "see `fitter/parts.py` for how they are derived.", "",
+              "see `fitter/model_build/parts.py` for how they are derived.", "",
               "![part labels, front and side](model_parts.png)", ""]
     write_text(args.docs / "model.md", "\n".join(lines))
     print(f"wrote {args.docs / 'model.md'} and {args.docs / 'model_parts.png'}")

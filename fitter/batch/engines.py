@@ -29,8 +29,8 @@ from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import file_sha256
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import file_sha256
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome, run_subject
 
 __all__ = ["WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker"]
@@ -84,7 +84,7 @@ def start_worker(setup: WorkerSetup):
 
         torch.set_num_threads(setup.threads)
         cv2.setNumThreads(setup.threads)
-    from bodyfit.fitter.model_cache import active_model_path, load_model
+    from bodyfit.fitter.model.cache import active_model_path, load_model
 
     path = active_model_path()
     if file_sha256(path) != setup.model_sha256:

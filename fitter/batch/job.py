@@ -3,9 +3,9 @@
 Every engine places jobs and calls :func:`run_subject` in a worker; nothing else decides
 what a subject's fit is. A job is `fitter run` for one row of the subjects table: the
 row's photos, stature, masks, camera, sex and weights, and the batch's options for all
-the rest (:mod:`bodyfit.fitter.run_options`, as `fitter run` reads its own), every
+the rest (:mod:`bodyfit.fitter.run.options`, as `fitter run` reads its own), every
 subject with the batch's seed. Its outputs go to OUT/<id>/ exactly as `fitter run`
-writes them (:func:`bodyfit.fitter.run.run_person`), moved into place in one rename, so
+writes them (:func:`bodyfit.fitter.run.results.run_person`), moved into place in one rename, so
 a worker killed at any moment leaves OUT/<id>/ complete or absent.
 """
 
@@ -19,14 +19,13 @@ import time
 from collections.abc import Mapping
 from pathlib import Path
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter.body_model import BodyModel
-from bodyfit.fitter.fit import FitSettings
-from bodyfit.fitter.person import PersonInputs
-from bodyfit.fitter.run import run_person
-from bodyfit.fitter.run_options import fit_settings
-
+from bodyfit.common.errors import UserError
 from bodyfit.fitter.batch.subjects import SubjectRow
+from bodyfit.fitter.fit.person import PersonInputs
+from bodyfit.fitter.fit.person_fit import FitSettings
+from bodyfit.fitter.model.body_model import BodyModel
+from bodyfit.fitter.run.options import fit_settings
+from bodyfit.fitter.run.results import run_person
 
 __all__ = ["SubjectJob", "SubjectOutcome", "WORKER_EXIT_HOOK", "subject_job", "run_subject",
            "one_line"]
@@ -87,12 +86,12 @@ def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object
                 out_dir: Path) -> SubjectJob:
     """The job of one row: the row's inputs (its camera and sex, else the batch's
     ``options["camera"]`` and ``options["sex"]``; the batch's background plates) and
-    ``base`` with the batch's fit options (:func:`~bodyfit.fitter.run_options.fit_settings`),
+    ``base`` with the batch's fit options (:func:`~bodyfit.fitter.run.options.fit_settings`),
     the row's weights replacing ``--weights`` (``--weight`` overrides still apply).
 
     Args:
         base: the method's or the run.json's settings
-            (:func:`~bodyfit.fitter.run_options.base_settings`).
+            (:func:`~bodyfit.fitter.run.options.base_settings`).
         options: the batch's options by argparse name, None when not given; paths
             absolute.
         out_dir: OUT, absolute.
@@ -101,12 +100,12 @@ def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object
         UserError: the row's weights file is malformed.
         ValueError: a bad matching or vertical anchor option.
     """
-    inputs = PersonInputs(row.front, row.side, row.height_cm,
-                          camera=row.camera or options.get("camera"),
-                          mask_front=row.mask_front, mask_side=row.mask_side,
-                          background_front=options.get("background_front"),
-                          background_side=options.get("background_side"),
-                          sex=row.sex or options.get("sex") or "unknown")
+    given = row.inputs
+    inputs = dataclasses.replace(
+        given, camera=given.camera or options.get("camera"),
+        background_front=options.get("background_front"),
+        background_side=options.get("background_side"),
+        sex=given.sex if given.sex != "unknown" else options.get("sex") or "unknown")
     if row.weights is not None:
         options = {**options, "weights": row.weights}
     return SubjectJob(row.subject_id, inputs, fit_settings(base, options),

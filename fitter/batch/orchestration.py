@@ -28,16 +28,15 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from bodyfit.calib.command_line import bodyfit_version
-from bodyfit.calib.errors import UserError
-from bodyfit.calib.files import TEMP_FILE_PATTERN, created_folders
-from bodyfit.fitter.outputs import STAGE_PATTERN, write_json
+from bodyfit.common.command_line import bodyfit_version
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import TEMP_FILE_PATTERN, created_folders
+from bodyfit.fitter.output.result_files import STAGE_PATTERN, write_json
 
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome
 from bodyfit.fitter.batch.subjects import SubjectTable
 from bodyfit.fitter.batch.tables import (FAILURES_FILE, STATUSES, SUMMARY_FILE, SummaryRow,
-                                         missing_results, read_previous, summary_row,
-                                         write_tables)
+                                         missing_results, read_previous, summary_row, write_tables)
 
 __all__ = ["BATCH_FILE", "LOCK_FILE", "BatchResult", "run_batch"]
 

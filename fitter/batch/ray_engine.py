@@ -25,7 +25,7 @@ import logging
 import math
 from collections.abc import Callable, Iterable
 
-from bodyfit.calib.errors import UserError
+from bodyfit.common.errors import UserError
 from bodyfit.fitter.batch.engines import WorkerDeaths, WorkerSetup, start_worker
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome, one_line, run_subject
 

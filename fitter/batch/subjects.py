@@ -11,7 +11,7 @@ A UTF-8 CSV file with a header row. Columns (any order, names as written here):
   down), as ``fitter run --front/--side``;
 - ``height_cm`` (required): stature, centimetres;
 - ``camera``, ``mask_front``, ``mask_side`` (optional): as the ``fitter run`` options;
-- ``sex`` (optional): female, male or unknown;
+- ``sex`` (optional): female, male or unknown (empty or unknown: the batch's ``--sex``);
 - ``weights`` (optional): a weights preset or a .toml file, as ``--weights``.
 
 An empty optional cell means "not given" (the batch's option, if any, applies). Relative
@@ -19,7 +19,7 @@ paths are relative to the folder of SUBJECTS.csv, so a table travels with its ph
 they are made absolute here. Blank lines are ignored.
 
 Problems of the whole table (unreadable file, a missing, unknown or repeated column)
-are :class:`~bodyfit.calib.errors.UserError`; problems of one row (a wrong number of
+are :class:`~bodyfit.common.errors.UserError`; problems of one row (a wrong number of
 cells, an empty required cell, a height that is not a number or not a stature, an unknown
 sex or weights preset, an unsafe or repeated id, a path that does not exist) are
 :class:`BadRow`, which ``fitter batch`` reports and stops on, or skips with
@@ -33,9 +33,9 @@ import dataclasses
 import re
 from pathlib import Path
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter.person import SEXES, STATURE_RANGE_CM
-from bodyfit.fitter.weights import PRESETS
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.fit.person import SEXES, STATURE_RANGE_CM, PersonInputs
+from bodyfit.fitter.fit.weights import PRESETS
 
 __all__ = ["REQUIRED_COLUMNS", "OPTIONAL_COLUMNS", "RESERVED_IDS", "SubjectRow", "BadRow",
            "SubjectTable", "read_subjects", "id_problem"]
@@ -50,24 +50,19 @@ _ID_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 
 @dataclasses.dataclass(frozen=True)
 class SubjectRow:
-    """One good row of the table: a subject, its paths absolute.
+    """One good row of the table: a subject and its inputs, paths absolute.
 
     Attributes:
         subject_id: the id (its output folder's name).
-        front, side: photo paths; height_cm: stature, centimetres.
-        camera, mask_front, mask_side: paths or None; sex: one of ``SEXES`` or None;
+        inputs: the row's photos, stature, camera, masks and sex as `fitter run` takes
+            them; a camera or sex the row leaves empty is None or ``"unknown"``, and the
+            batch's ``--camera``/``--sex`` apply (:func:`~bodyfit.fitter.batch.job.subject_job`).
         weights: a preset name, a .toml path, or None.
         line: the row's line number in the file (1 is the header).
     """
 
     subject_id: str
-    front: str
-    side: str
-    height_cm: float
-    camera: str | None = None
-    mask_front: str | None = None
-    mask_side: str | None = None
-    sex: str | None = None
+    inputs: PersonInputs
     weights: str | None = None
     line: int = 0
 
@@ -166,8 +161,8 @@ def _row(cells: dict[str, str], line: int, folder: Path) -> SubjectRow:
     if not lo <= height_cm <= hi:
         raise ValueError(f"height_cm must be a stature in centimetres, {lo:.0f}-{hi:.0f}; "
                          f"got {height_cm:g}")
-    sex = cells.get("sex") or None
-    if sex is not None and sex not in SEXES:
+    sex = cells.get("sex") or "unknown"
+    if sex not in SEXES:
         raise ValueError(f"sex must be one of {', '.join(SEXES)} (or empty), got {sex!r}")
     paths = {}
     for name in _PATH_COLUMNS:
@@ -185,8 +180,8 @@ def _row(cells: dict[str, str], line: int, folder: Path) -> SubjectRow:
         if not path.is_file():
             raise ValueError(f"weights {weights}: no such file")
         weights = str(path)
-    return SubjectRow(cells["id"], height_cm=height_cm, sex=sex, weights=weights, line=line,
-                      **paths)
+    return SubjectRow(cells["id"], PersonInputs(height_cm=height_cm, sex=sex, **paths),
+                      weights, line)
 
 
 def read_subjects(path: Path) -> SubjectTable:

@@ -29,10 +29,10 @@ import math
 from collections.abc import Sequence
 from pathlib import Path
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter.measurements import MEASUREMENTS
-from bodyfit.fitter.outputs import write_text
-from bodyfit.fitter.run import RUN_FILES
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.measure.measurements import MEASUREMENTS
+from bodyfit.fitter.output.result_files import write_text
+from bodyfit.fitter.run.results import RUN_FILES
 
 __all__ = ["SUMMARY_FILE", "FAILURES_FILE", "STATUSES", "SUMMARY_COLUMNS", "FAILURES_COLUMNS",
            "SummaryRow", "PreviousBatch", "missing_results", "summary_row", "csv_text",

@@ -4,16 +4,10 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.calib.boards import (
-    CHESSBOARD_ATTEMPTS,
-    BoardDetector,
-    BoardSpec,
-    canonical_chessboard_order,
-    parse_board,
-    render_board,
-)
-from bodyfit.calib.errors import UserError
+from bodyfit.calib.boards import (CHESSBOARD_ATTEMPTS, BoardDetector, BoardSpec,
+                                  canonical_chessboard_order, parse_board, render_board,)
 from bodyfit.calib.synthetic import BoardPhotoRenderer
+from bodyfit.common.errors import UserError
 
 K = np.array([[900.0, 0.0, 480.0], [0.0, 900.0, 270.0], [0.0, 0.0, 1.0]])
 NO_DIST = np.zeros(5)

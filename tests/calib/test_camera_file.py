@@ -7,7 +7,7 @@ import pytest
 
 from bodyfit.calib.boards import parse_board
 from bodyfit.calib.camera import Camera, camera_fields, load_camera
-from bodyfit.calib.errors import UserError
+from bodyfit.common.errors import UserError
 
 CAMERA = Camera(
     (1280, 720),

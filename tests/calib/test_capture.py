@@ -7,16 +7,10 @@ import numpy as np
 import pytest
 
 from bodyfit.calib.boards import BoardDetector, render_board
-from bodyfit.calib.capture import (
-    DISTORTION_MODELS,
-    CaptureSettings,
-    ViewStatus,
-    calibrate,
-    collect_views,
-    describe_views,
-)
-from bodyfit.calib.errors import UserError
+from bodyfit.calib.capture import (DISTORTION_MODELS, CaptureSettings, BoardViewStatus, calibrate,
+                                   collect_views, describe_views,)
 from bodyfit.calib.synthetic import BoardPhotoRenderer, random_board_poses
+from bodyfit.common.errors import UserError
 
 from calib_true_camera import IMAGE_SIZE, TRUE_DIST, TRUE_K
 
@@ -59,9 +53,9 @@ def test_rejects_a_blurred_view_and_an_outlier_and_still_recovers(chessboard_sho
     shots = chessboard_shots
     calibration = solve(shots, [*shots.sharp, shots.blurred, shots.bent])
     status = {view.source: view for view in calibration.views}
-    assert status[str(shots.blurred)].status is ViewStatus.BLURRY
+    assert status[str(shots.blurred)].status is BoardViewStatus.BLURRY
     assert status[str(shots.blurred)].edge_rise_px > SETTINGS.max_edge_rise_px
-    assert status[str(shots.bent)].status is ViewStatus.OUTLIER
+    assert status[str(shots.bent)].status is BoardViewStatus.OUTLIER
     assert status[str(shots.bent)].error_px > 1.0
     assert describe_views(calibration.views) == f"{len(shots.sharp)} used, 2 rejected (1 too blurry, 1 outlier)"
     assert calibration.worst_view.error_px < 0.2
@@ -123,7 +117,7 @@ def test_video_frames_are_sampled_and_repeated_positions_skipped(tmp_path, charu
     assert size_found == size and len(views) == 16
     assert [view.frame_index // 3 for view in views] == list(range(16))  # one frame from each stretch
     statuses = [view.status for view in views]
-    assert statuses == [ViewStatus.USED, ViewStatus.DUPLICATE] * 8
+    assert statuses == [BoardViewStatus.USED, BoardViewStatus.DUPLICATE] * 8
     calibration = calibrate(views, size, settings, spec)
     assert calibration.camera.K[0, 0] == pytest.approx(small_k[0, 0], rel=0.01)
 

@@ -22,9 +22,9 @@ from hypothesis import strategies as st
 
 from bodyfit.calib.camera import Camera, camera_fields, load_camera
 from bodyfit.calib.cli import main
-from bodyfit.calib.errors import UserError
 from bodyfit.calib.images import read_photo
 from bodyfit.calib.silhouette import load_mask
+from bodyfit.common.errors import UserError
 
 from calib_true_camera import TRUE_DIST, TRUE_K
 

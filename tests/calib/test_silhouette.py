@@ -7,15 +7,11 @@ import numpy as np
 import pytest
 
 from bodyfit.calib.camera import Camera
-from bodyfit.calib.errors import UserError
-from bodyfit.calib.silhouette import (
-    SilhouetteSettings,
-    extract_silhouette,
-    load_mask,
-    photo_silhouette,
-)
+from bodyfit.calib.silhouette import (SilhouetteSettings, extract_silhouette, load_mask,
+                                      photo_silhouette,)
 from bodyfit.calib.synthetic import distort_image
 from bodyfit.calib.undistort import undistort_image
+from bodyfit.common.errors import UserError
 
 from calib_scenes import BACKDROP, SKIN, clutter, exif_with_orientation, iou, studio_photo
 

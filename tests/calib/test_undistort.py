@@ -6,9 +6,9 @@ import pytest
 from scipy.spatial import cKDTree
 
 from bodyfit.calib.camera import Camera
-from bodyfit.calib.errors import UserError
 from bodyfit.calib.synthetic import distort_image
 from bodyfit.calib.undistort import undistort_image
+from bodyfit.common.errors import UserError
 
 from calib_true_camera import IMAGE_SIZE, TRUE_DIST, TRUE_K
 

@@ -17,13 +17,13 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.kernels import cpu_threads
 from bodyfit.fitter.batch.job import WORKER_EXIT_HOOK
 from bodyfit.fitter.batch.subjects import read_subjects
-from bodyfit.fitter.cli import main
-from bodyfit.fitter.model_cache import CACHE_ENV_VAR
-from bodyfit.fitter.run import RUN_FILES
-from bodyfit.fitter.studio_photos import write_subject
+from bodyfit.fitter.cli.main import main
+from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.model.cache import CACHE_ENV_VAR
+from bodyfit.fitter.run.results import RUN_FILES
+from bodyfit.kernels import cpu_threads
 
 #: A tiny budget: the tests check the batch, not the fit's accuracy.
 BUDGET = ["--projection", "orthographic", "--optimizer", "cmaes", "--population", "8",
@@ -216,7 +216,7 @@ def test_killed_batch_resumes_with_every_subject_done_exactly_once(local_batch, 
     out = tmp_path / "out"
     argv = [table, "-o", out, "--workers", 1, "--threads", 5, *BUDGET]
     process = subprocess.Popen(
-        [sys.executable, "-m", "bodyfit.fitter.cli", "-q", "batch", *map(str, argv)],
+        [sys.executable, "-m", "bodyfit.fitter.cli.main", "-q", "batch", *map(str, argv)],
         start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 180
     try:
@@ -386,7 +386,7 @@ def test_table_paths_are_relative_to_its_folder(tmp_path, monkeypatch):
     read = read_subjects(table)
     assert not read.bad_rows
     a, b = read.rows
-    assert (a.front, a.camera, a.weights, a.sex, a.line) == (
+    assert (a.inputs.front, a.inputs.camera, a.weights, a.inputs.sex, a.line) == (
         str(photos / "f.png"), str(photos / "cam.json"), str(photos / "w.toml"), "female", 2)
-    assert (b.front, b.camera, b.weights, b.sex, b.height_cm) == (
-        str(photos / "f.png"), None, "paper", None, 165.5)
+    assert (b.inputs.front, b.inputs.camera, b.weights, b.inputs.sex, b.inputs.height_cm) == (
+        str(photos / "f.png"), None, "paper", "unknown", 165.5)

@@ -6,11 +6,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter import model_cache
-from bodyfit.fitter.body_model import BodyModel, project_shape, rest_shape
-from bodyfit.fitter.model_build import ModelBuildSettings
-from bodyfit.fitter.population_sampler import PopulationSampler
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.model import cache as model_cache
+from bodyfit.fitter.model.body_model import BodyModel, project_shape, rest_shape
+from bodyfit.fitter.model_build.body_sample import BodySampler
+from bodyfit.fitter.model_build.builder import ModelBuildSettings, build_and_save
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "model.md"
 
@@ -35,12 +35,12 @@ def test_body_from_the_space_round_trips(body_model):
     assert np.abs(again - vertices).max() < 2e-5  # metres
 
 
-def test_population_betas_reproduce_population_measurements(body_model, measurer):
-    """The stored population is the one the space was learned from: 60 components
+def test_sample_betas_reproduce_sample_measurements(body_model, measurer):
+    """The stored sample is the one the space was learned from: 60 components
     reconstruct its first bodies' measurements closely."""
-    vertices, _ = rest_shape(body_model, body_model.population_betas[:4])
+    vertices, _ = rest_shape(body_model, body_model.sample_betas[:4])
     got = measurer.measure_many(vertices)
-    assert np.nanmax(np.abs(got - body_model.population_measurements[:4])) < 5.0  # mm
+    assert np.nanmax(np.abs(got - body_model.sample_measurements[:4])) < 5.0  # mm
 
 
 def documented_k20_errors():
@@ -55,12 +55,12 @@ def test_held_out_body_within_documented_error(body_model, anny_source, measurer
     """Bodies the space never saw (another seed) reconstruct with K=20 within the error
     docs/model.md reports (mean over a few bodies; generous factor for so few)."""
     mean_mm, p95_mm = documented_k20_errors()
-    settings = ModelBuildSettings.of(body_model).population
-    population = PopulationSampler(anny_source, measurer, settings).sample(
+    settings = ModelBuildSettings.of(body_model).sampling
+    sample = BodySampler(anny_source, measurer, settings).sample(
         {"male": 2, "female": 2}, seed=987)
-    betas = project_shape(body_model, population.vertices, population.joints, 20)
+    betas = project_shape(body_model, sample.vertices, sample.joints, 20)
     rebuilt, _ = rest_shape(body_model, betas)
-    err_mm = np.linalg.norm(rebuilt - population.vertices, axis=2) * 1000
+    err_mm = np.linalg.norm(rebuilt - sample.vertices, axis=2) * 1000
     assert err_mm.mean() <= 1.5 * mean_mm
     assert np.percentile(err_mm, 95) <= 1.5 * p95_mm
 
@@ -128,26 +128,26 @@ def test_pickled_file_error_gives_no_pickle_advice(tmp_path):
 
 
 def test_small_build_saves_and_loads(tmp_path, monkeypatch):
-    """The build end to end on a small population (the full one takes minutes): the
+    """The build end to end on a small sample (the full one takes minutes): the
     user-built model in the cache then takes the shipped one's place."""
-    from bodyfit.fitter.population_sampler import PopulationSettings
+    from bodyfit.fitter.model_build.body_sample import SamplingSettings
 
     monkeypatch.setenv(model_cache.CACHE_ENV_VAR, str(tmp_path))
     settings = ModelBuildSettings(components=6, samples=100, seed=3,
-                                  population=PopulationSettings(iterations=1, pool_per_sex=60))
-    built = model_cache.build_and_save(settings, progress=False)
+                                  sampling=SamplingSettings(iterations=1, pool_per_sex=60))
+    built = build_and_save(settings, progress=False)
     assert model_cache.active_model_path() == model_cache.model_path()
     loaded = model_cache.load_model()
-    assert loaded.num_components == 6 and len(loaded.population_sex) == 100
+    assert loaded.num_components == 6 and len(loaded.sample_sex) == 100
     assert ModelBuildSettings.of(loaded) == settings
     np.testing.assert_array_equal(loaded.vertex_components, built.vertex_components)
-    # the population is centred and whitened by the PCA: betas have mean 0, variance 1
-    np.testing.assert_allclose(loaded.population_betas.mean(axis=0), 0, atol=1e-3)
-    np.testing.assert_allclose(loaded.population_betas.var(axis=0, ddof=1), 1, atol=1e-3)
+    # the sample is centred and whitened by the PCA: betas have mean 0, variance 1
+    np.testing.assert_allclose(loaded.sample_betas.mean(axis=0), 0, atol=1e-3)
+    np.testing.assert_allclose(loaded.sample_betas.var(axis=0, ddof=1), 1, atol=1e-3)
 
 
 def test_principal_components_match_numpy_svd():
-    from bodyfit.fitter.model_build import principal_components
+    from bodyfit.fitter.model_build.builder import principal_components
 
     rng = np.random.default_rng(5)
     data = (rng.standard_normal((120, 120)) * np.exp(-np.arange(120) / 8.0)) @ \

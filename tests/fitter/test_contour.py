@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.fitter.contour import contour_points, normalise_contour, rigid_icp
+from bodyfit.fitter.fit.contour import contour_points, normalise_contour, rigid_icp
 
 
 def _figure() -> np.ndarray:

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, abduction_rotations, forward, rest_shape
+from bodyfit.fitter.model.body_model import (PART_NAMES, POSE_NAMES, abduction_rotations, forward,
+                                             rest_shape)
 
 
 @pytest.fixture(scope="module")

@@ -5,11 +5,11 @@ import pytest
 import trimesh
 from scipy.spatial import ConvexHull
 
-from bodyfit.fitter.anny_source import SHAPE_PARAMETERS
-from bodyfit.fitter.measurements import MEASUREMENTS, SECTION_GIRTHS
-from bodyfit.fitter.population_sampler import SEXES, ReferenceStats
-from bodyfit.fitter.sections import (hull_perimeter, mesh_edges, section_centre,
-                                     section_points, tape_lengths)
+from bodyfit.fitter.measure.measurements import MEASUREMENTS, SECTION_GIRTHS
+from bodyfit.fitter.measure.sections import (hull_perimeter, mesh_edges, section_centre,
+                                             section_points, tape_lengths)
+from bodyfit.fitter.model_build.anny_source import SHAPE_PARAMETERS
+from bodyfit.fitter.model_build.body_sample import SEXES, ReferenceStats
 
 KEYS = list(MEASUREMENTS)
 
@@ -143,12 +143,12 @@ def test_a_bigger_local_change_gives_a_bigger_girth(anny_source, measurer, chang
 
 
 @pytest.mark.parametrize("sex", SEXES)
-def test_population_resembles_ansur(body_model, sex):
+def test_sample_resembles_ansur(body_model, sex):
     """The issue's realism bar: per sex, means and SDs within 10 % of ANSUR II for
     stature, chest, waist, hip, thigh, biacromial breadth and crotch height; the main
     correlations of the same sign and similar size."""
     ref = ReferenceStats.load()
-    pop = body_model.population_measurements[body_model.population_sex == SEXES.index(sex)]
+    pop = body_model.sample_measurements[body_model.sample_sex == SEXES.index(sex)]
     for key in "ODEFLPK":
         col, r = pop[:, KEYS.index(key)], ref.keys.index(key)
         assert abs(col.mean() / ref.mean[sex][r] - 1) < 0.10, key

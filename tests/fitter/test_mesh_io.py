@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter.mesh_io import read_mesh, write_mesh
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.output.mesh_io import read_mesh, write_mesh
 
 
 @pytest.mark.parametrize("suffix", [".obj", ".ply"])

@@ -13,8 +13,8 @@ import trimesh
 from hypothesis import given
 from hypothesis import strategies as st
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter.mesh_io import read_mesh
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.output.mesh_io import read_mesh
 
 SPHERE = trimesh.creation.icosphere(subdivisions=1, radius=0.85)  # 1.7 m tall: a plausible size
 FACES = np.asarray(SPHERE.faces)

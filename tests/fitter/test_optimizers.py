@@ -3,26 +3,15 @@ both optimisers, reproducibility, and the analytic case of a shifted sphere (the
 is known). No body model: the costs are written here."""
 
 import dataclasses
-import doctest
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from bodyfit.fitter import optimizers
-from bodyfit.fitter.optimizers import (
-    CmaEvolutionStrategy,
-    CmaSettings,
-    GeneticAlgorithm,
-    GeneticSettings,
-    crossover,
-    draw_cut_points,
-    draw_parents,
-    make_optimizer,
-    mutate,
-    search_bounds,
-)
+from bodyfit.fitter.fit.optimizers import (CmaEvolutionStrategy, CmaSettings, GeneticAlgorithm,
+                                           GeneticSettings, crossover, draw_cut_points,
+                                           draw_parents, make_optimizer, mutate, search_bounds,)
 
 LOWER, UPPER = search_bounds(20, (-10.0, 30.0))  # D = 24: 20 betas (sd), 4 angles (deg)
 SPAN = UPPER - LOWER
@@ -49,10 +38,6 @@ def run(opt, cost):
         asked.append(x)
         opt.tell(x, cost(x))
     return asked
-
-
-def test_module_examples():
-    assert doctest.testmod(optimizers).failed == 0
 
 
 # ------------------------------------------------------------------------ GA operators
@@ -344,7 +329,7 @@ def test_search_forgets_the_best_when_the_costs_change_meaning():
     (True), the best so far restarts from the next generation's costs."""
     from types import SimpleNamespace
 
-    from bodyfit.fitter.search import SearchSettings, search
+    from bodyfit.fitter.fit.search import SearchSettings, search
 
     offset = {"value": 0.0}
 
@@ -403,7 +388,7 @@ def test_search_answers_with_the_cmaes_centre_scored():
     best candidate scored."""
     from types import SimpleNamespace
 
-    from bodyfit.fitter.search import SearchSettings, search
+    from bodyfit.fitter.fit.search import SearchSettings, search
 
     target = np.array([0.5, -1.0, 0.8])
     rng = np.random.default_rng(5)
@@ -426,7 +411,7 @@ def test_search_answers_with_the_cmaes_centre_scored():
 
 
 def test_averaged_searches_pad_average_and_add_up():
-    from bodyfit.fitter.search import SearchResult, averaged
+    from bodyfit.fitter.fit.search import SearchResult, averaged
 
     def result(best_costs, betas, evaluations, population):
         g = len(best_costs)
@@ -449,7 +434,7 @@ def test_averaged_searches_pad_average_and_add_up():
 
 
 def test_refined_search_joins_the_curves_and_pads_the_first_betas():
-    from bodyfit.fitter.search import SearchResult, refined
+    from bodyfit.fitter.fit.search import SearchResult, refined
 
     def result(k, generations, population, value):
         return SearchResult(
@@ -479,7 +464,7 @@ def test_search_starts_cmaes_from_the_given_genes():
     (sigma0 0.01 of the ranges), and a GA, which keeps no distribution, refuses one."""
     from types import SimpleNamespace
 
-    from bodyfit.fitter.search import SearchSettings, search
+    from bodyfit.fitter.fit.search import SearchSettings, search
 
     asked = []
 
@@ -507,7 +492,7 @@ def test_searches_together_score_one_population_and_equal_searches_alone():
     its search run alone."""
     from types import SimpleNamespace
 
-    from bodyfit.fitter.search import SearchSettings, search, searches_together
+    from bodyfit.fitter.fit.search import SearchSettings, search, searches_together
 
     target = np.array([0.5, -1.0, 0.8])
     sizes = []

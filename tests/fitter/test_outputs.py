@@ -2,7 +2,7 @@
 
 import pytest
 
-from bodyfit.fitter.outputs import staged_directory, write_text
+from bodyfit.fitter.output.result_files import staged_directory, write_text
 
 
 def test_staged_directory_moves_every_file_in_at_the_end(tmp_path):
@@ -54,7 +54,7 @@ def test_staged_directory_takes_an_empty_folders_place_in_one_step(tmp_path):
 
 
 def test_stage_pattern_names_the_folder_a_staging_folder_is_for(tmp_path):
-    from bodyfit.fitter.outputs import STAGE_PATTERN
+    from bodyfit.fitter.output.result_files import STAGE_PATTERN
 
     for name in ("s1", "a.b", "x.0123abcd"):
         with staged_directory(tmp_path / name) as stage:

@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial import cKDTree
 
-from bodyfit.fitter.body_model import PART_NAMES
+from bodyfit.fitter.model.body_model import PART_NAMES
 
 
 def test_every_vertex_has_one_of_the_ten_parts(body_model):

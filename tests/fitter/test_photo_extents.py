@@ -8,15 +8,15 @@ import numpy as np
 import pytest
 
 from bodyfit import kernels
-from bodyfit.fitter import photo_extents
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
-from bodyfit.fitter.measurements import LIMB_SECTIONS
-from bodyfit.fitter.photo_extents import (MAX_CHANGE, WHOLE_SECTION, ViewPhoto, extent_ratio,
-                                          outline_width, person_width,
-                                          photo_scaled_measurements, placed_camera,
-                                          silhouette_axis, turned_to_tape)
-from bodyfit.fitter.pinhole_canvas import Placement
-from bodyfit.fitter.side_arms import side_photo_pose
+from bodyfit.fitter.fit import photo_extents
+from bodyfit.fitter.fit.photo_extents import (MAX_CHANGE, WHOLE_SECTION, ViewPhoto, extent_ratio,
+                                              outline_width, person_width,
+                                              photo_scaled_measurements, placed_camera,
+                                              silhouette_axis, turned_to_tape)
+from bodyfit.fitter.fit.pinhole_canvas import Placement
+from bodyfit.fitter.fit.side_arms import side_photo_pose
+from bodyfit.fitter.measure.measurements import LIMB_SECTIONS
+from bodyfit.fitter.model.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
 
 PHOTO_SHAPE = (1600, 1200)
 K = np.array([[1500.0, 0, 599.5], [0, 1500.0, 799.5], [0, 0, 1]])

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from bodyfit import kernels
-from bodyfit.fitter.body_model import forward
-from bodyfit.fitter.render import centre_samples, coverage_mask
+from bodyfit.fitter.model.body_model import forward
+from bodyfit.fitter.output.render import centre_samples, coverage_mask
 from bodyfit.kernels.view_camera import camera_matrices
 
 

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from bodyfit import kernels
-from bodyfit.fitter.body_model import PART_NAMES, forward
-from bodyfit.fitter.render_mesh import CLUSTERED_PARTS, render_model
+from bodyfit.fitter.fit.render_mesh import CLUSTERED_PARTS, render_model
+from bodyfit.fitter.model.body_model import PART_NAMES, forward
 from bodyfit.kernels.target import visible_faces
 from bodyfit.kernels.view_camera import camera_matrices
 

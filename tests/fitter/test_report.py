@@ -11,18 +11,18 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter import fit as fit_module
-from bodyfit.fitter.cli import main
-from bodyfit.fitter.body_model import PART_NAMES
-from bodyfit.fitter.fit import FitSettings
-from bodyfit.fitter.measurements import MEASUREMENTS
-from bodyfit.fitter.person import PersonInputs
-from bodyfit.fitter.render import PART_COLOURS_BGR
-from bodyfit.fitter.run_config import read_run_config, run_config
-from bodyfit.fitter.search import SearchSettings
-from bodyfit.fitter.spreads import SPREAD_NOTES, bodyfit_calibration, recorded_answer_cost
-from bodyfit.fitter.studio_photos import write_subject
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.cli.main import main
+from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.fit import person_fit as fit_module
+from bodyfit.fitter.fit.person import PersonInputs
+from bodyfit.fitter.fit.person_fit import FitSettings
+from bodyfit.fitter.fit.search import SearchSettings
+from bodyfit.fitter.fit.spreads import SPREAD_NOTES, bodyfit_calibration, recorded_answer_cost
+from bodyfit.fitter.measure.measurements import MEASUREMENTS
+from bodyfit.fitter.model.body_model import PART_NAMES
+from bodyfit.fitter.output.render import PART_COLOURS_BGR
+from bodyfit.fitter.run.config import read_run_config, run_config
 from bodyfit.kernels import CostSettings
 
 BETAS = np.r_[0.5, np.zeros(19)]
@@ -193,8 +193,8 @@ def test_without_config_the_person_is_required(capsys):
 def test_components_at_or_past_the_refinement_turn_it_off(options, refine):
     """bodyfit's refinement over 40 components adds none to a search of 40 or more: it is
     off unless --refine-components is given too (and then validated as given)."""
-    from bodyfit.fitter.fit import METHODS
-    from bodyfit.fitter.run_options import fit_settings
+    from bodyfit.fitter.fit.person_fit import METHODS
+    from bodyfit.fitter.run.options import fit_settings
 
     settings = fit_settings(METHODS["bodyfit"], {"components": None, **options})
     assert settings.search.refine_components == refine
@@ -206,7 +206,7 @@ def test_the_default_method_reports_the_calibrated_spread(first_run, tmp_path, c
                                                            monkeypatch):
     """A run of other settings than the default method's reports its population's spread;
     one of the default method (here: the first run's settings made the default), with
-    another seed, the calibrated ± (fitter/spreads.py): each measurement's factor times
+    another seed, the calibrated ± (fitter/fit/spreads.py): each measurement's factor times
     the answers' mean cost, as written in run.json."""
     first = json.loads((first_run / "measurements.json").read_text())
     assert first["spread_basis"] == "population"

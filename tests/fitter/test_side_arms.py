@@ -5,14 +5,14 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
-from bodyfit.fitter.fit import FitSettings, fit_person
-from bodyfit.fitter.person import PersonInputs, person_masks
-from bodyfit.fitter.search import SearchSettings
-from bodyfit.fitter.side_arms import arms_down_deg, side_photo_pose, side_view_options
-from bodyfit.fitter.studio_photos import write_subject
 from bodyfit import kernels
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.fit.person import PersonInputs, person_masks
+from bodyfit.fitter.fit.person_fit import FitSettings, fit_person
+from bodyfit.fitter.fit.search import SearchSettings
+from bodyfit.fitter.fit.side_arms import arms_down_deg, side_photo_pose, side_view_options
+from bodyfit.fitter.model.body_model import PART_NAMES, POSE_NAMES, forward, rest_shape
 
 BETAS = np.array([0.8, -0.6, 0.5, 0.3, -0.4] + [0.0] * 15)
 POSE = np.array([6.0, 6.0, 3.0, 3.0])

@@ -1,4 +1,4 @@
-"""The ± of a fit's measurements (fitter/spreads.py): the calibration, its file, when it
+"""The ± of a fit's measurements (fitter/fit/spreads.py): the calibration, its file, when it
 applies, and the answer cost it scales with."""
 
 import dataclasses
@@ -7,12 +7,12 @@ import json
 import numpy as np
 import pytest
 
-from bodyfit.fitter.fit import METHODS, FitSettings
-from bodyfit.fitter.measurements import MEASUREMENTS
-from bodyfit.fitter.search import SearchSettings
-from bodyfit.fitter.spreads import (COVERAGE, SpreadCalibration, answer_cost,
-                                    bodyfit_calibration, calibration_applies,
-                                    read_calibration, recorded_answer_cost)
+from bodyfit.fitter.fit.person_fit import METHODS, FitSettings
+from bodyfit.fitter.fit.search import SearchSettings
+from bodyfit.fitter.fit.spreads import (COVERAGE, SpreadCalibration, answer_cost,
+                                        bodyfit_calibration, calibration_applies, read_calibration,
+                                        recorded_answer_cost)
+from bodyfit.fitter.measure.measurements import MEASUREMENTS
 
 
 def test_made_from_errors_proportional_to_the_cost_gives_their_ratio():
@@ -41,7 +41,7 @@ def test_made_from_holds_its_share_of_the_subjects():
 
 def test_calibration_file_round_trips_and_bad_files_are_refused():
     calibration = SpreadCalibration.made_from(np.ones((3, 16)), np.array([1.0, 2.0, 4.0]),
-                                              "python tools/bench_accuracy.py spread ...")
+                                              "python -m bench.accuracy spread ...")
     assert read_calibration(json.dumps(calibration.as_json())) == calibration
     with pytest.raises(ValueError, match="not a spread calibration"):
         read_calibration(json.dumps({"format": "bodyfit.camera/1"}))

@@ -1,4 +1,4 @@
-"""Weight presets, files and overrides (bodyfit.fitter.weights), down to the kernels' cost."""
+"""Weight presets, files and overrides (bodyfit.fitter.fit.weights), down to the kernels' cost."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import json
 import numpy as np
 import pytest
 
-from bodyfit.calib.errors import UserError
-from bodyfit.fitter.body_model import PART_NAMES, forward
-from bodyfit.fitter.weights import (PRESETS, WEIGHT_NAMES, cost_settings, load_weights_file,
-                                    parse_override, resolve_weights, settings_from_record,
-                                    weights_record)
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.fit.weights import (PRESETS, WEIGHT_NAMES, cost_settings, load_weights_file,
+                                        parse_override, resolve_weights, settings_from_record,
+                                        weights_record)
+from bodyfit.fitter.model.body_model import PART_NAMES, forward
 from bodyfit.kernels import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, SIDE_VIEW_PARTS, TERM_NAMES,
                              CostSettings, ModelArrays, PopulationEvaluator, orthographic_camera,
                              prepare_view_target, rasterize)
@@ -45,7 +45,7 @@ def test_presets_have_the_documented_values():
 
 
 def test_paper_preset_is_the_kernels_default_and_bodyfit_the_fitters():
-    from bodyfit.fitter.fit import FitSettings
+    from bodyfit.fitter.fit.person_fit import FitSettings
 
     assert cost_settings("paper") == CostSettings()
     assert weights_record(CostSettings()) == TABLE_2
@@ -205,7 +205,7 @@ def scene(body_model):
                            HEIGHT, width).numpy()[0]
         views[name] = prepare_view_target(name, labels >= 0, _camera(name),
                                           1000.0 / PIXELS_PER_METRE, parts)
-    model = ModelArrays.from_body_model(body_model, num_betas=20, device="cpu")
+    model = ModelArrays.from_body_model(body_model, num_components=20, device="cpu")
     candidates_pose = np.repeat(pose, 2, axis=0)
     candidates_pose[0, :2] += 12.0
     candidates_pose[1, 2:] += 4.0

@@ -9,4 +9,4 @@ from bodyfit.kernels.skinning import ModelArrays
 
 @pytest.fixture(scope="session")
 def model_arrays(body_model):
-    return ModelArrays.from_body_model(body_model, num_betas=20, device="cpu")
+    return ModelArrays.from_body_model(body_model, num_components=20, device="cpu")

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 import warp as wp
 
-from bodyfit.fitter.body_model import PART_NAMES, forward
-from bodyfit.kernels.view_camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
+from bodyfit.fitter.model.body_model import PART_NAMES, forward
 from bodyfit.kernels.raster import rasterize
 from bodyfit.kernels.target import visible_faces
+from bodyfit.kernels.view_camera import FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera
 
 #: The canvas of the tests: 512 px high like the benchmark; widths fit each view.
 HEIGHT = 512

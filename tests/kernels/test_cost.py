@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from bodyfit.fitter.body_model import PART_NAMES, POSE_NAMES
-from bodyfit.kernels.view_camera import SIDE_VIEW_DEG, orthographic_camera
+from bodyfit.fitter.model.body_model import PART_NAMES, POSE_NAMES
 from bodyfit.kernels.cost import MATCHING_DIRECTIONS, TERM_NAMES, CostSettings
 from bodyfit.kernels.evaluator import PopulationEvaluator, evaluate_population
 from bodyfit.kernels.reference import population_cost, view_terms
 from bodyfit.kernels.skinning import ModelArrays
 from bodyfit.kernels.target import SIDE_VIEW_PARTS, prepare_view_target
+from bodyfit.kernels.view_camera import SIDE_VIEW_DEG, orthographic_camera
 
 from kernel_scenes import (DEVICES, FRONT_WIDTH, HEIGHT, PIXELS_PER_METRE, SIDE_WIDTH,
                            front_camera, random_bodies, render_labels, side_camera)
@@ -183,7 +183,7 @@ def test_empty_silhouette_costs_infinity(model_arrays, views, truth):
 @pytest.mark.parametrize("device", DEVICES)
 def test_costs_are_the_same_on_every_device(body_model, model_arrays, views, truth,
                                             candidates, device):
-    model = ModelArrays.from_body_model(body_model, num_betas=20, device=device)
+    model = ModelArrays.from_body_model(body_model, num_components=20, device=device)
     costs = evaluate_population(model, _views(body_model, *truth, device=device), *candidates)
     on_cpu = evaluate_population(model_arrays, views, *candidates)
     assert np.allclose(costs.costs, on_cpu.costs, rtol=1e-5)

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 import scipy.ndimage as ndi
 
-from bodyfit.fitter.body_model import forward
-from bodyfit.kernels.view_camera import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera,
-                                         paper_rotation, pinhole_camera)
+from bodyfit.fitter.model.body_model import forward
 from bodyfit.kernels.raster import project, rasterize
 from bodyfit.kernels.reference import project_vertices, render_label_maps
+from bodyfit.kernels.view_camera import (FRONT_VIEW_DEG, SIDE_VIEW_DEG, orthographic_camera,
+                                         paper_rotation, pinhole_camera)
 
 from kernel_scenes import (DEVICES, FRONT_WIDTH, HEIGHT, SIDE_WIDTH, box_mesh, front_camera,
                            random_bodies, side_camera)

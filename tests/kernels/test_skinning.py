@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import warp as wp
 
-from bodyfit.fitter.body_model import forward
+from bodyfit.fitter.model.body_model import forward
 from bodyfit.kernels.device import resolve_device
 from bodyfit.kernels.skinning import ModelArrays, skin
 
@@ -17,7 +17,7 @@ from kernel_scenes import DEVICES, random_bodies
 
 @pytest.mark.parametrize("device", DEVICES)
 def test_skin_matches_numpy_forward(body_model, device):
-    model = ModelArrays.from_body_model(body_model, num_betas=20, device=device)
+    model = ModelArrays.from_body_model(body_model, num_components=20, device=device)
     betas, pose = random_bodies(6, seed=1, spread=3.0)
     pose[0] = [30.0, 0.0, -10.0, 45.0]  # outside the GA's range too
     posed = skin(model, betas, pose).numpy()
@@ -69,4 +69,4 @@ def test_unavailable_device_is_a_clear_error(body_model):
 
 def test_too_many_betas_is_a_value_error(body_model):
     with pytest.raises(ValueError, match="stores"):
-        ModelArrays.from_body_model(body_model, num_betas=body_model.num_components + 1)
+        ModelArrays.from_body_model(body_model, num_components=body_model.num_components + 1)

@@ -1,0 +1,68 @@
+"""What the fitter benchmarks share: drawing in-space subjects, fitting them by command,
+their errors' table cells.
+
+Imported by the tools/bench_*.py scripts (run as ``python tools/bench_X.py``, which puts
+this folder on the import path).
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+
+from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
+
+__all__ = ["ERROR_HEADER", "draw_subject", "fit_by_command", "fit_each_setting", "error_cells"]
+
+#: The Markdown header cells of :func:`error_cells`.
+ERROR_HEADER = "7 important, mean abs. error (mm) | " + " | ".join(IMPORTANT) + " | O"
+
+
+def draw_subject(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """An in-space subject: (20,) betas normal, clipped at +-2 sigma; (4,) limbs 2-8
+    degrees out."""
+    return np.clip(rng.standard_normal(20), -2, 2), rng.uniform(2, 8, 4)
+
+
+def fit_by_command(folder: Path, truth: dict[str, float], out: Path,
+                   options: list[str]) -> tuple[float, list[float]]:
+    """Fit the subject photographed in ``folder`` (front.png, side.png) with the `fitter run`
+    command itself, start-up included; return (wall seconds, the 16 errors fitted - true
+    in ``MEASUREMENTS`` order, mm)."""
+    start = time.perf_counter()
+    subprocess.run(["fitter", "-q", "run", "--front", str(folder / "front.png"), "--side",
+                    str(folder / "side.png"), "--height-cm", f"{truth['O'] / 10:.2f}",
+                    "-o", str(out), *options], check=True, stdout=subprocess.DEVNULL)
+    seconds = time.perf_counter() - start
+    table = json.loads((out / "measurements.json").read_text())["measurements"]
+    return seconds, [table[name]["value_mm"] - truth[key]
+                     for key, (name, _) in MEASUREMENTS.items()]
+
+
+def fit_each_setting(folder: Path, truth: dict[str, float], settings: dict[str, list[str]],
+                     common: list[str], errors: dict[str, list], seconds: dict[str, list]
+                     ) -> None:
+    """Fit the subject in ``folder`` once per setting (its options after ``common``;
+    ``{camera}`` in an option stands for ``folder/camera.json``) by :func:`fit_by_command`
+    into ``folder/out<i>``, appending the wall seconds and the 16 errors to
+    ``seconds[name]`` and ``errors[name]``."""
+    for index, (name, options) in enumerate(settings.items()):
+        options = [option.format(camera=folder / "camera.json") for option in options]
+        wall, error = fit_by_command(folder, truth, folder / f"out{index}", [*common, *options])
+        seconds[name].append(wall)
+        errors[name].append(error)
+
+
+def error_cells(errors: list[list[float]]) -> str:
+    """The cells of ``ERROR_HEADER`` for (subjects, 16) errors in ``MEASUREMENTS`` order:
+    the 7 important measurements' mean absolute error, each one's, and the stature's, mm."""
+    keys = list(MEASUREMENTS)
+    important = [keys.index(k) for k in IMPORTANT]
+    err = np.abs(np.array(errors))
+    return " | ".join(f"{value:.1f}" for value in
+                      [err[:, important].mean(), *err[:, important].mean(axis=0),
+                       err[:, keys.index("O")].mean()])

@@ -1,0 +1,536 @@
+"""`fitter`: fit the body model to a person's photos, measure meshes, build the model.
+
+The help says only what exists. User errors, usage errors included, print one line,
+``fitter: error: ...``, and exit with status 2. `fitter batch` exits with status 1 when
+it ran but some subjects were not fitted (its failures.csv says why).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+import time
+from pathlib import Path
+
+from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import check_input_file
+
+__all__ = ["main"]
+
+logger = logging.getLogger("bodyfit")
+
+
+def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
+    """`fitter run`'s options; `fitter batch` takes the same fit options for every subject
+    (its table gives each subject's photos, stature, masks and optionally camera, sex and
+    weights)."""
+    if batch:
+        parser.add_argument("--config", type=Path, metavar="run.json",
+                            help="the settings of a previous run's run.json (not its "
+                                 "person; the options given here override them)")
+    else:
+        parser.add_argument("--config", type=Path, metavar="run.json",
+                            help="repeat a previous run: its inputs and settings from its "
+                                 "run.json (the options given here override them)")
+    parser.add_argument("--method", choices=("bodyfit", "paper"),
+                        help="bodyfit (default: CMA-ES 30 x 150, stature-conditioned "
+                             "candidates, model-to-person matching, bodyfit weights, the "
+                             "camera placed anew from the best body) or paper (the "
+                             "paper's method exactly: its GA 30 x 25, Table 2 weights, "
+                             "person-to-model matching); the options below override single "
+                             "settings")
+    if not batch:
+        parser.add_argument("--front", metavar="PHOTO", help="front photo, A-pose (required "
+                            "without --config)")
+        parser.add_argument("--side", metavar="PHOTO",
+                            help="side photo (the person's left side), arms hanging down")
+        parser.add_argument("--height-cm", type=float, metavar="CM",
+                            help="the person's stature, centimetres")
+        parser.add_argument("-o", "--output", type=Path, metavar="OUT",
+                            help="output folder (created; must be empty unless --overwrite)")
+    parser.add_argument("--camera", metavar="camera.json",
+                        help="the calibrated camera (calib capture): the photos are "
+                             "undistorted and fitted through it"
+                             + ("; for the rows without a camera" if batch else ""))
+    parser.add_argument("--projection", choices=("orthographic", "pinhole"),
+                        help="pinhole: the camera of --camera, or without it a typical phone "
+                             "camera (70 degrees across the long side); "
+                             "orthographic: the paper's, each view scaled from the stature "
+                             "(default pinhole; --method paper: orthographic)")
+    parser.add_argument("--placement-rounds", type=int, metavar="N",
+                        help="pinhole: place the camera anew from the search's best body so "
+                             "far N times, evenly spaced (default 2; 0: from the mean body "
+                             "only)")
+    if not batch:
+        parser.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
+                            "(white person on black, of the undistorted upright photo)")
+        parser.add_argument("--mask-side", metavar="PNG", help="your own side silhouette")
+    parser.add_argument("--background-front", metavar="PHOTO",
+                        help="background plate: the front view without the person")
+    parser.add_argument("--background-side", metavar="PHOTO",
+                        help="background plate, side view")
+    parser.add_argument("--sex", choices=("female", "male", "unknown"),
+                        help="recorded with the run (default unknown)"
+                             + ("; for the rows without a sex" if batch else ""))
+    parser.add_argument("--weights", metavar="PRESET|FILE.toml",
+                        help="cost weights: bodyfit (Table 2 without the top and bottom "
+                             "terms, the head and neck 4; the default), paper (Table 2; "
+                             "the paper method's), "
+                             "uniform, lower-body, or a .toml file"
+                             + ("; for the rows without weights" if batch else ""))
+    parser.add_argument("--weight", action="append", metavar="NAME=VALUE",
+                        help="override one weight, e.g. waist=8 or view.side=3 (repeatable)")
+    parser.add_argument("--matching",
+                        help="boundary matching direction: model_to_person (default), "
+                             "person_to_model (the paper's) or symmetric (both)")
+    parser.add_argument("--vertical-anchor", choices=("centroid", "extremes"),
+                        help="how candidates are shifted vertically onto the person: "
+                             "centroid (the paper's moments) or extremes (the middle of the "
+                             "top and bottom rows; the default)")
+    parser.add_argument("--side-arms", choices=("down", "hidden"),
+                        help="the side view's candidates: down (default) with their arms "
+                             "hanging down, as the side photo shows them; hidden: without "
+                             "arms (for a side photo whose arms hide within the torso)")
+    parser.add_argument("--optimizer", choices=("ga", "cmaes"),
+                        help="cmaes: CMA-ES (default); ga: the paper's genetic algorithm")
+    parser.add_argument("--population", type=int, help="candidates per generation "
+                        "(default 30)")
+    parser.add_argument("--generations", type=int,
+                        help="generations (default 150; --method paper: 25)")
+    parser.add_argument("--components", type=int,
+                        help="shape components searched (default 20, as the paper; up to "
+                             "60)")
+    parser.add_argument("--seed", type=int, help="random seed (default 0)"
+                        + ("; every subject uses it" if batch else ""))
+    parser.add_argument("--searches", type=int,
+                        help="independent searches (seeds SEED, SEED+1, ...) whose answers "
+                             "are averaged (default 2; --method paper: 1)")
+    parser.add_argument("--refine-components", type=int, metavar="K",
+                        help="after the searches, refine their answer with CMA-ES over the "
+                             "first K components, --refinements of them, averaged (more "
+                             "than --components; default 40, none when --components is 40 "
+                             "or more; 0: none; --method paper: 0)")
+    parser.add_argument("--refine-generations", type=int,
+                        help="each refinement's generations (default 500)")
+    parser.add_argument("--refinements", type=int,
+                        help="refinements (seeds SEED, SEED+1, ...) whose answers are averaged "
+                             "(default 6)")
+    parser.add_argument("--free-stature", action="store_true", default=None,
+                        help="search the first shape component like the others (the paper) "
+                             "instead of solving it so every candidate stands as tall as the "
+                             "person")
+    parser.add_argument("--device", help="cpu (default) or cuda:0"
+                        + ("; cuda: one worker per GPU" if batch else ""))
+    parser.add_argument("--threads", type=int,
+                        help="CPU threads scoring each generation (default: one per core"
+                             + ("; fitter batch: the cores shared among the local workers"
+                                if batch else "") + "; the result does not depend on it)")
+    if not batch:
+        parser.add_argument("--overwrite", action="store_true",
+                            help="write into a non-empty OUT")
+
+
+def _build_parser() -> argparse.ArgumentParser:
+    parser = OneLineArgumentParser(
+        prog="fitter",
+        description="bodyfit: a 3D body and 16 tape measurements from a front and a side "
+                    "photo (fitter run); draw and measure bodies of the model. Lengths in "
+                    "files are metres (meshes) and millimetres (measurements).")
+    parser.add_argument("--version", action="version", version=f"bodyfit {bodyfit_version()}")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    model = sub.add_parser("model", help="build or inspect the body model")
+    model_sub = model.add_subparsers(dest="model_command", required=True, metavar="ACTION")
+    build = model_sub.add_parser(
+        "build", help="build the body model from Anny into the cache (about 4 minutes; "
+                      "bodyfit ships a default model, so this is for other settings)")
+    build.add_argument("--components", type=int, default=60,
+                       help="PCA shape components to store (default 60; fitting uses 20)")
+    build.add_argument("--samples", type=int, default=3000,
+                       help="bodies in the sample, half men, half women (default 3000)")
+    build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    build.add_argument("-o", "--output", type=Path,
+                       help="write the model here instead of the cache (.npz); "
+                            "fitter/data/body_model.npz is the model bodyfit ships")
+    model_sub.add_parser("info", help="print which model is used and how it was built")
+
+    demo = sub.add_parser(
+        "demo", help="the main job on a synthetic person: photos and board photos through "
+                     "one phone camera, calibration, fitter run --camera, measured vs true (mm)",
+        description="Photograph a synthetic person (front, A-pose; side, arms down) and a "
+                    "chessboard through one synthetic phone camera with lens distortion, "
+                    "calibrate it as calib capture does, fit the person as fitter run "
+                    "--camera does, and print the 16 fitted measurements against the true "
+                    "ones (mm). Writes the photos, camera.json, truth.json and the fit "
+                    "(DIR/fit) into DIR (docs/fitter.md, The demo).")
+    demo.add_argument("-o", "--output", type=Path, default=Path("out/demo"), metavar="DIR",
+                      help="output folder (default out/demo; the demo's earlier files there "
+                           "are replaced)")
+    demo.add_argument("--seed", type=int, default=0,
+                      help="which body, camera place and board poses are drawn (default 0)")
+    demo.add_argument("--generations", type=int, metavar="G",
+                      help="the searches' and the refinements' generations (default: "
+                           "fitter run's)")
+
+    run = sub.add_parser(
+        "run", help="fit the body model to a person's front and side photos: mesh (m), "
+                    "16 measurements (mm), convergence plot, run record",
+        description="Fit bodyfit's body model to a front photo (A-pose) and a side photo "
+                    "(arms hanging down) on a plain backdrop. Cameras: with --camera, "
+                    "the calibrated pinhole camera, the person's distance solved from the "
+                    "stature; without, see --projection (docs/fitter.md, Cameras).")
+    _add_fit_options(run, batch=False)
+
+    batch = sub.add_parser(
+        "batch", help="fit every subject of a table (SUBJECTS.csv) as fitter run does, on "
+                      "local worker processes or a Ray cluster; resumable",
+        description="Fit every row of SUBJECTS.csv (columns id, front, side, height_cm; "
+                    "optional camera, mask_front, mask_side, sex, weights; relative paths "
+                    "are relative to the CSV's folder) as fitter run does, into OUT/<id>/, "
+                    "with OUT/summary.csv, OUT/failures.csv and OUT/batch.json. Subjects "
+                    "already fitted in OUT are kept; a subject that fails is recorded and "
+                    "the batch goes on. Exit status 0: every subject fitted; 1: some "
+                    "failed; 2: bad input (docs/batch.md).")
+    batch.add_argument("subjects", type=Path, metavar="SUBJECTS.csv",
+                       help="the subjects table, one row per subject")
+    batch.add_argument("-o", "--output", type=Path, metavar="OUT", required=True,
+                       help="output folder (created; a rerun into it resumes the batch)")
+    batch.add_argument("--workers", type=int, metavar="N",
+                       help="subjects fitted at once (default: one per CPU core, or per "
+                            "GPU with --device cuda; with --ray, as many as the cluster's "
+                            "resources hold)")
+    batch.add_argument("--ray", action="store_true",
+                       help="run the subjects as Ray tasks (pip install 'bodyfit[ray]'): "
+                            "on a local Ray instance, or on --ray-address's cluster")
+    batch.add_argument("--ray-address", metavar="ADDR",
+                       help="join this Ray cluster (e.g. ray://head:10001 or auto; implies "
+                            "--ray); inputs and OUT must lie on a file system every node "
+                            "sees at the same path")
+    batch.add_argument("--cpus-per-worker", type=float, metavar="C",
+                       help="with --ray: CPUs Ray reserves per worker (default 1)")
+    batch.add_argument("--gpus-per-worker", type=float, metavar="G",
+                       help="with --ray and --device cuda: GPUs per worker, a fraction when "
+                            "several fit on one GPU (default 1)")
+    batch.add_argument("--retry-failed", action="store_true",
+                       help="fit again the subjects OUT/failures.csv lists (a rerun skips "
+                            "them otherwise)")
+    batch.add_argument("--skip-bad-rows", action="store_true",
+                       help="skip the table's bad rows, each reported, instead of stopping")
+    _add_fit_options(batch, batch=True)
+
+    measure = sub.add_parser("measure", help="the 16 measurements (mm) of a mesh in the "
+                                             "model's topology (.obj/.ply)")
+    measure.add_argument("mesh", type=Path, help="mesh file, .obj or .ply")
+    measure.add_argument("--units", choices=("m", "cm", "mm"), default="m",
+                         help="length unit of the mesh file (default m)")
+    measure.add_argument("-o", "--output", type=Path,
+                         help="write JSON here (and CSV beside it); default: print only")
+    return parser
+
+
+def _cmd_model_build(args) -> None:
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    from bodyfit.common.files import check_writable_dir
+    from bodyfit.fitter.model.cache import model_path
+    from bodyfit.fitter.model_build.builder import ModelBuildSettings, build_and_save
+
+    settings = ModelBuildSettings(components=args.components, samples=args.samples,
+                                  seed=args.seed)
+    settings.validate()
+    path = args.output or model_path()
+    if path.suffix != ".npz":
+        raise UserError(f"-o takes a .npz path, got {path}")
+    check_writable_dir(path.parent)
+    with logging_redirect_tqdm():
+        model = build_and_save(settings, path, progress=None if not args.quiet else False)
+    t = model.metadata["timings_s"]
+    print(f"built the body model in {t['total']:.0f} s: {model.num_vertices} vertices, "
+          f"{model.num_components} components, {len(model.sample_sex)} bodies")
+    print(f"wrote {path}")
+
+
+def _cmd_model_info(args) -> None:
+    from bodyfit.fitter.model.cache import active_model_path, load_model, model_path
+
+    t0 = time.perf_counter()
+    model = load_model()
+    load_s = time.perf_counter() - t0
+    meta = model.metadata
+    path = active_model_path()
+    origin = "built by you" if path == model_path() else "shipped with bodyfit"
+    print(f"body model ({origin}): {path} ({path.stat().st_size / 1e6:.1f} MB, "
+          f"loaded in {load_s * 1000:.0f} ms)")
+    print(f"  {model.num_vertices} vertices, {len(model.faces)} faces, "
+          f"{model.num_components} components ({meta['explained_variance']:.6f} of the "
+          f"sample's variance)")
+    print(f"  built from anny {meta['anny_version']} with {meta['settings']} "
+          f"in {meta['timings_s']['total']:.0f} s")
+
+
+def _cmd_demo(args) -> None:
+    import shlex
+
+    from bodyfit.fitter.demo.example import (DemoSettings, calibrate_scene, measurement_table,
+                                             write_scene)
+    from bodyfit.fitter.fit.spreads import SPREAD_NOTES
+    from bodyfit.fitter.model.cache import load_model
+    from bodyfit.fitter.run.results import run_person
+
+    if args.generations is not None and args.generations < 1:
+        raise UserError(f"--generations must be at least 1, got {args.generations}")
+    model = load_model()
+    scene = write_scene(model, args.output, DemoSettings(seed=args.seed))
+    calibration, camera_path, coverage_path = calibrate_scene(scene)
+    fx_true, fx = scene.camera.K[0, 0], calibration.camera.K[0, 0]
+    print(f"calibrated the phone camera from {len(scene.board_photos)} board photos "
+          f"({len(calibration.used_views)} used): fx {fx:.1f} px (true {fx_true:.1f}), "
+          f"k1 {calibration.camera.dist[0]:+.3f} (true {scene.camera.dist[0]:+.3f}), "
+          f"RMS {calibration.rms_px:.3f} px")
+    # the fit is `fitter run` on the demo's files, with its defaults and its settings logic
+    run_argv = ["run", "--front", str(scene.front), "--side", str(scene.side),
+                "--height-cm", f"{scene.truth['O'] / 10:.1f}", "--camera", str(camera_path),
+                "-o", str(args.output / "fit"), "--overwrite"]
+    if args.generations is not None:
+        run_argv += ["--generations", str(args.generations),
+                     "--refine-generations", str(args.generations)]
+    run_args = _build_parser().parse_args(run_argv)
+    inputs, settings, output = _run_settings(run_args)
+    fit, written = run_person(model, inputs, settings, output, run_args.overwrite,
+                              progress=None if not args.quiet else False)
+    result = fit.search
+    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {result.evaluations} candidates, "
+          f"{result.generations} generations ({settings.search.optimizer}, "
+          f"{settings.projection})")
+    print("\n".join(measurement_table(fit.measurements, fit.spreads, scene.truth)))
+    print(f"  ({SPREAD_NOTES[fit.spread_basis]})")
+    print("wrote:")
+    for path in (scene.front, scene.side, scene.board_photos[0].parent, camera_path,
+                 coverage_path, scene.truth_file, *written):
+        print(f"  {path}")
+    print(f"fit the photos again by hand: fitter {shlex.join(run_argv)}")
+
+
+def _run_settings(args):
+    """(PersonInputs, FitSettings, output folder) of `fitter run`'s options: the defaults,
+    or with --config the run.json's values, overridden by every option given."""
+    import dataclasses
+
+    from bodyfit.fitter.fit.person import PersonInputs
+    from bodyfit.fitter.run.options import INPUT_OPTIONS, base_settings, fit_settings
+
+    given = {k: v for k, v in vars(args).items() if v is not None}
+    if args.config is None:
+        missing = [f"--{k.replace('_', '-')}" for k in ("front", "side", "height_cm")
+                   if k not in given] + ([] if args.output else ["-o"])
+        if missing:
+            raise UserError(f"fitter run needs {', '.join(missing)} (or --config run.json)")
+    settings, config = base_settings(args.method, args.config)
+    if config is None:
+        inputs, output = PersonInputs(args.front, args.side, args.height_cm), args.output
+    else:
+        inputs, output = config.inputs, args.output or config.output
+        if output is None:
+            raise UserError(f"{args.config} records no output folder; give -o OUT")
+    inputs = dataclasses.replace(inputs, **{k: given[k] for k in INPUT_OPTIONS if k in given})
+    return inputs, fit_settings(settings, given), output
+
+
+def _cmd_run(args) -> None:
+    from bodyfit.fitter.fit.spreads import SPREAD_NOTES
+    from bodyfit.fitter.measure.measurements import MEASUREMENTS
+    from bodyfit.fitter.model.cache import load_model
+    from bodyfit.fitter.run.results import run_person
+
+    try:
+        inputs, settings, output = _run_settings(args)
+        model = load_model()
+        fit, written = run_person(model, inputs, settings, output, args.overwrite,
+                                  progress=None if not args.quiet else False)
+    except ValueError as exc:  # the kernels' argument and device errors, --matching
+        raise UserError(str(exc)) from None
+    result = fit.search
+    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {result.evaluations} candidates, "
+          f"{result.generations} generations, best cost {result.cost:.1f} weighted mm")
+    for key, (_, label) in MEASUREMENTS.items():
+        print(f"  {key} {label:<28} {fit.measurements[key]:8.1f} ± "
+              f"{fit.spreads[key]:5.1f} mm")
+    print(f"  ({SPREAD_NOTES[fit.spread_basis]})")
+    print("wrote:")
+    for path in written:
+        print(f"  {path}")
+
+
+def _batch_engine(args, model_sha256: str):
+    """The engine of `fitter batch`'s options: local processes, or Ray."""
+    import dataclasses
+
+    from bodyfit.fitter.batch.engines import LocalEngine, WorkerSetup
+    from bodyfit.kernels import cpu_threads
+
+    device = args.device or "cpu"
+    setup = WorkerSetup(model_sha256,
+                        log_level=logging.ERROR if args.quiet else logging.WARNING)
+    if args.ray or args.ray_address:
+        from bodyfit.fitter.batch.ray_engine import RayEngine
+
+        cpus = args.cpus_per_worker or 1.0
+        gpus = args.gpus_per_worker if args.gpus_per_worker is not None else (
+            1.0 if device.startswith("cuda") else 0.0)
+        setup = dataclasses.replace(setup, threads=max(1, int(cpus)))
+        return RayEngine(args.ray_address, args.workers, setup, cpus, gpus)
+    if args.cpus_per_worker is not None or args.gpus_per_worker is not None:
+        raise UserError("--cpus-per-worker and --gpus-per-worker are for --ray")
+    if device.startswith("cuda"):
+        import warp
+
+        warp.init()
+        count = warp.get_cuda_device_count()
+        devices = tuple(f"cuda:{i}" for i in range(count)) if device == "cuda" else (device,)
+        if count == 0 or not set(devices) <= {f"cuda:{i}" for i in range(count)}:
+            raise UserError(f"--device {device}: this machine has {count} CUDA devices")
+        setup = dataclasses.replace(setup, devices=devices)
+        workers = len(devices) if args.workers is None else args.workers  # one per GPU
+    else:
+        workers = cpu_threads() if args.workers is None else args.workers  # one per core
+    threads = max(1, cpu_threads() // max(1, workers))  # each worker's share of the cores
+    return LocalEngine(workers, dataclasses.replace(setup, threads=threads))
+
+
+def _batch_jobs(args):
+    """(the subjects table, id -> job) of `fitter batch`'s options; every problem of the
+    options or the table is a UserError here, before any work."""
+    import dataclasses
+
+    from bodyfit.calib.camera import load_camera
+    from bodyfit.fitter.batch.job import subject_job
+    from bodyfit.fitter.batch.subjects import BadRow, read_subjects
+    from bodyfit.fitter.model.cache import load_model
+    from bodyfit.fitter.run.options import base_settings, fit_settings
+
+    options = dict(vars(args))
+    for name in ("camera", "background_front", "background_side", "weights"):
+        value = options[name]
+        if value is None or (name == "weights" and not value.endswith(".toml")):
+            continue
+        check_input_file(value, f"--{name.replace('_', '-')} {value}")
+        options[name] = str(Path(value).absolute())
+    if options["camera"]:
+        load_camera(options["camera"])
+    table = read_subjects(args.subjects)
+    base, _ = base_settings(args.method, args.config)
+    try:
+        fit_settings(base, options).validate(load_model().num_components)
+    except ValueError as exc:  # --matching
+        raise UserError(str(exc)) from None
+    jobs, bad_rows = {}, list(table.bad_rows)
+    for row in table.rows:
+        try:
+            jobs[row.subject_id] = subject_job(row, base, options, args.output.absolute())
+        except UserError as exc:  # the row's weights file
+            bad_rows.append(BadRow(row.line, row.subject_id, str(exc)))
+    table = dataclasses.replace(table, rows=[row for row in table.rows
+                                             if row.subject_id in jobs],
+                                bad_rows=sorted(bad_rows, key=lambda bad: bad.line))
+    if table.bad_rows and not args.skip_bad_rows:
+        more = len(table.bad_rows) - 1
+        raise UserError(table.bad_rows[0].message(args.subjects)
+                        + (f" (and {more} more bad row{'s' * (more > 1)})" if more else "")
+                        + "; fix the table, or pass --skip-bad-rows to skip bad rows")
+    return table, jobs
+
+
+def _cmd_batch(args) -> int:
+    import signal
+
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    from bodyfit.common.files import check_writable_dir, file_sha256
+    from bodyfit.fitter.batch.orchestration import run_batch
+    from bodyfit.fitter.batch.tables import STATUSES
+    from bodyfit.fitter.model.cache import active_model_path
+
+    check_writable_dir(args.output)
+    if args.output.exists() and not args.output.is_dir():
+        raise UserError(f"output folder {args.output} is a file")
+    table, jobs = _batch_jobs(args)
+    engine = _batch_engine(args, file_sha256(active_model_path()))
+    for bad in table.bad_rows:  # every check passed: the work starts
+        print(f"fitter batch: skipping {bad.message(args.subjects)}", file=sys.stderr)
+
+    def stop(signum, frame):  # `kill` (a scheduler's time limit) stops as Ctrl-C does
+        raise KeyboardInterrupt
+
+    previous_handler = signal.signal(signal.SIGTERM, stop)
+    try:
+        with logging_redirect_tqdm():
+            result = run_batch(table, jobs, args.output, engine, args.retry_failed,
+                               progress=None if not args.quiet else False,
+                               command=["fitter", *args.argv])
+    finally:
+        signal.signal(signal.SIGTERM, previous_handler)
+    counts = {status: result.count(status) for status in STATUSES}
+    workers = f", {engine.workers} workers" if engine.workers else ""
+    print(f"fitter batch: {len(result.rows)} subjects in {result.seconds:.1f} s "
+          f"({engine.name}{workers}): "
+          + ", ".join(f"{n} {status}" for status, n in counts.items() if n))
+    print("wrote:")
+    for path in result.written:
+        print(f"  {path}")
+    # 0 when every subject of the table is fitted; failures are in failures.csv
+    return 0 if counts["fitted"] + counts["fitted earlier"] == len(result.rows) else 1
+
+
+def _cmd_measure(args) -> None:
+    from bodyfit.fitter.measure.measurements import MEASUREMENTS, Measurer
+    from bodyfit.fitter.model.cache import load_model
+    from bodyfit.fitter.output.mesh_io import read_mesh
+    from bodyfit.fitter.output.result_files import write_measurements
+
+    model = load_model()
+    vertices = read_mesh(args.mesh, model.faces, args.units)
+    values = Measurer.from_model(model).measure(vertices)
+    for key, value in values.items():
+        print(f"  {key} {MEASUREMENTS[key][1]:<28} {value:8.1f} mm")
+    if args.output:
+        if args.output.suffix.lower() != ".json":
+            raise UserError(f"-o takes a .json path, got {args.output}")
+        csv_path = write_measurements(args.output, {args.mesh.stem: values},
+                                      {"command": "fitter measure", "mesh": str(args.mesh),
+                                       "units": args.units})
+        print(f"wrote {args.output} and {csv_path}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        args = _build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help, --version, usage errors: argparse has printed
+        return int(stop.code or 0)
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # recorded by fitter batch
+    logging.basicConfig(level=logging.ERROR if args.quiet else logging.INFO,
+                        format="%(message)s")
+    for chatty in ("anny", "bodyfit.calib"):  # their steps are logged for `calib -v`
+        logging.getLogger(chatty).setLevel(logging.WARNING)
+    import warp  # Warp prints its banner and module loads at INFO; the CLI keeps to errors
+
+    warp.config.log_level = warp.LOG_ERROR
+    command = {"batch": _cmd_batch, "demo": _cmd_demo, "measure": _cmd_measure,
+               "run": _cmd_run}.get(args.command)
+    if args.command == "model":
+        command = {"build": _cmd_model_build, "info": _cmd_model_info}[args.model_command]
+    try:
+        code = command(args)
+    except UserError as exc:
+        print(f"fitter: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("fitter: interrupted", file=sys.stderr)
+        return 130
+    return code or 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

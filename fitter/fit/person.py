@@ -1,0 +1,120 @@
+"""The person's inputs: two photos (or the user's own masks), the stature, the camera.
+
+Photos go through calib: read in the sensor frame, silhouette on the plain backdrop
+(optionally against a background plate), undistorted with the camera when one is given,
+turned upright by EXIF (:func:`bodyfit.calib.silhouette.photo_silhouette`). A user's
+mask replaces the extraction; it must be of the undistorted, upright photo.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from bodyfit.calib.camera import load_camera
+from bodyfit.calib.images import read_photo
+from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
+from bodyfit.common.errors import UserError
+from bodyfit.common.files import check_input_file
+from bodyfit.fitter.fit.pinhole_canvas import phone_intrinsics, upright_intrinsics
+
+__all__ = ["PersonInputs", "STATURE_RANGE_CM", "person_masks", "view_intrinsics"]
+
+#: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
+#: most likely given in other units).
+STATURE_RANGE_CM = (100.0, 250.0)
+SEXES = ("female", "male", "unknown")
+
+
+@dataclasses.dataclass(frozen=True)
+class PersonInputs:
+    """What the user gives about one person (paths as given).
+
+    Attributes:
+        front, side: the photos: front in an A-pose, side with the arms hanging down.
+        height_cm: stature, centimetres.
+        camera: camera.json from ``calib capture``, or None.
+        mask_front, mask_side: the user's own silhouettes (white person on black), or None.
+        background_front, background_side: background plates, or None.
+        sex: "female", "male" or "unknown" (recorded; not yet a prior of the search).
+    """
+
+    front: str
+    side: str
+    height_cm: float
+    camera: str | None = None
+    mask_front: str | None = None
+    mask_side: str | None = None
+    background_front: str | None = None
+    background_side: str | None = None
+    sex: str = "unknown"
+
+    def validate(self) -> None:
+        lo, hi = STATURE_RANGE_CM
+        if not lo <= self.height_cm <= hi:
+            raise UserError(f"--height-cm must be a stature in centimetres, {lo:.0f}-{hi:.0f}; "
+                            f"got {self.height_cm:g}")
+        if self.sex not in SEXES:
+            raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
+        for path in (self.front, self.side, self.camera, self.mask_front, self.mask_side,
+                     self.background_front, self.background_side):
+            if path is not None:
+                check_input_file(path)
+
+
+def _view_mask(photo: str, mask: str | None, background: str | None, camera) -> np.ndarray:
+    if mask is not None:
+        return load_mask(mask)
+    return photo_silhouette(photo, camera, background, SilhouetteSettings())
+
+
+def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
+    """{"front": mask, "side": mask}: (H, W) bool silhouettes of the upright photos.
+
+    Raises:
+        UserError: unreadable files, no person, several people, a person cut by the frame,
+            photos of another size than the camera's, or front and side swapped.
+    """
+    inputs.validate()
+    camera = load_camera(inputs.camera) if inputs.camera else None
+    masks = {"front": _view_mask(inputs.front, inputs.mask_front, inputs.background_front, camera),
+             "side": _view_mask(inputs.side, inputs.mask_side, inputs.background_side, camera)}
+    aspect = {}
+    for view, mask in masks.items():
+        rows, cols = np.nonzero(mask)
+        for edge, touching in (("top", rows.min() == 0), ("bottom", rows.max() == mask.shape[0] - 1),
+                               ("left", cols.min() == 0), ("right", cols.max() == mask.shape[1] - 1)):
+            if touching:
+                raise UserError(f"the person in the {view} silhouette touches the {edge} edge of "
+                                "the frame: the whole body must be in the photo")
+        aspect[view] = np.ptp(cols) / max(1, np.ptp(rows))
+    if aspect["side"] > aspect["front"]:
+        raise UserError(f"the side silhouette is wider than the front one ({aspect['side']:.2f} "
+                        f"vs {aspect['front']:.2f} of the height): are --front and --side swapped?")
+    return masks
+
+
+def view_intrinsics(inputs: PersonInputs, masks: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """{"front": K, "side": K}: (3, 3) pixels, the camera matrix of each upright photo.
+
+    camera.json's K turned as the photo's EXIF orientation turns it upright; without
+    camera.json, a typical phone's (:func:`bodyfit.fitter.fit.pinhole_canvas.phone_intrinsics`).
+
+    Raises:
+        UserError: a mirrored photo, or a mask of another size than the upright photo.
+    """
+    if inputs.camera is None:
+        return {view: phone_intrinsics(mask.shape) for view, mask in masks.items()}
+    camera = load_camera(inputs.camera)
+    found = {}
+    for view, mask in masks.items():
+        orientation = read_photo(getattr(inputs, view)).orientation
+        k = upright_intrinsics(camera.K, camera.image_size_px, orientation)
+        width, height = camera.image_size_px
+        size = (height, width) if orientation in (1, 3) else (width, height)
+        if mask.shape != size:
+            raise UserError(f"the {view} silhouette is {mask.shape[1]}x{mask.shape[0]} pixels but "
+                            f"the upright photo of the camera is {size[1]}x{size[0]}")
+        found[view] = k
+    return found

@@ -1,0 +1,441 @@
+"""One person's fit: silhouettes -> canvases -> search -> body and measurements with spreads.
+
+The ± of each measurement: :mod:`bodyfit.fitter.fit.spreads` (calibrated on the accuracy
+benchmark for the default method, the search's own scatter for other settings).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import time
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from bodyfit import kernels
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
+                                       orthographic_view)
+from bodyfit.fitter.fit.person import PersonInputs, person_masks, view_intrinsics
+from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
+from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew
+from bodyfit.fitter.fit.render_mesh import render_model
+from bodyfit.fitter.fit.search import (SearchResult, SearchSettings, averaged, refined, search,
+                                       searches_together)
+from bodyfit.fitter.fit.side_arms import side_view_options
+from bodyfit.fitter.fit.spreads import (answer_cost, bodyfit_calibration, calibration_applies,
+                                        population_spreads)
+from bodyfit.fitter.fit.stature import StatureConditioner, stature_scale
+from bodyfit.fitter.fit.weights import cost_settings
+from bodyfit.fitter.measure.measurements import Measurer
+from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, forward, rest_shape
+from bodyfit.kernels.target import visible_vertices
+
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fitted_bodies",
+           "fitted_measurements",
+           "person_views", "place_cameras", "placement_body", "refinement_scoring",
+           "stature_conditioner", "view_photos"]
+
+@dataclasses.dataclass(frozen=True)
+class FitSettings:
+    """Everything about a fit but the person.
+
+    Attributes:
+        search: optimiser and space.
+        canvas: canvas geometry.
+        cost: the kernels' weights, matching and alignment (default: the ``bodyfit``
+            weights preset, model -> person matching, the vertical anchor on the
+            extremes; docs/accuracy.md measured the matching directions).
+        device: where the kernels run, "cpu" or "cuda:0".
+        threads: CPU threads evaluating each population side by side (None: one per core
+            this process may use; ignored on a GPU). The result does not depend on it.
+        render_cell_mm: the candidates are rendered with the parts of
+            ``render_mesh.CLUSTERED_PARTS`` clustered to cubes of this size
+            (:mod:`bodyfit.fitter.fit.render_mesh`; 0: the full mesh).
+        side_arms: how the side view treats the person's arms, one of
+            ``bodyfit.fitter.fit.side_arms.SIDE_ARMS`` ("down": candidates rendered with their
+            arms hanging down; "hidden": without arms).
+        projection: "pinhole" (the photos' camera, or a typical phone's without one,
+            :mod:`bodyfit.fitter.fit.pinhole_canvas`; the default) or "orthographic" (the
+            paper's, each view scaled from the stature).
+        placement_rounds: pinhole only: how often the search places the cameras anew
+            from its best body so far (evenly spaced through the generations;
+            :func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`); 0: only from the mean
+            body, before the search.
+        photo_extents: pinhole only: the girths and the shoulder breadth of
+            :data:`~bodyfit.fitter.fit.photo_extents.SCALED` take their extents from the
+            photos (:mod:`bodyfit.fitter.fit.photo_extents`); False: every
+            measurement is the fitted mesh's.
+    """
+
+    search: SearchSettings = SearchSettings()
+    canvas: CanvasSettings = CanvasSettings()
+    cost: kernels.CostSettings = cost_settings(
+        "bodyfit", base=kernels.CostSettings(matching="model_to_person",
+                                             vertical_anchor="extremes"))
+    device: str = "cpu"
+    threads: int | None = None
+    render_cell_mm: float = 8.0
+    side_arms: str = "down"
+    projection: str = "pinhole"
+    placement_rounds: int = 2
+    photo_extents: bool = True
+
+    def validate(self, stored_components: int) -> None:
+        """Raise UserError for settings no person could be fitted with (one line, naming
+        the option)."""
+        self.search.validate(stored_components)
+        self.canvas.validate()
+        if self.threads is not None and self.threads < 1:
+            raise UserError(f"--threads must be at least 1, got {self.threads}")
+        if self.render_cell_mm < 0:
+            raise UserError(f"render_cell_mm must be >= 0, got {self.render_cell_mm}")
+        if self.projection not in ("orthographic", "pinhole"):
+            raise UserError(f"--projection must be orthographic or pinhole, got "
+                            f"{self.projection!r}")
+        if self.placement_rounds < 0:
+            raise UserError(f"placement_rounds must be >= 0, got {self.placement_rounds}")
+
+
+#: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
+#: docs/fitter.md "Choosing the defaults") and the paper's method exactly (Sections
+#: 3.3-3.4): one search, its GA at 30 x 25 over all 20 betas and the 4 angles, no
+#: refinement, Table 2's weights, the person -> model matching, the moments' alignment,
+#: its 512 px canvases, every measurement the fitted mesh's.
+METHODS = {
+    "bodyfit": FitSettings(),
+    "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
+                                               generations=None, condition_stature=False,
+                                               searches=1, refine_components=0),
+                         canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
+                         projection="orthographic",
+                         render_cell_mm=0.0, placement_rounds=0, photo_extents=False),
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class Fit:
+    """A fitted body.
+
+    Attributes:
+        search: the search's outcome (best parameters, convergence, final population).
+        posed: (V, 3) float32 metres, the best body in its fitted pose.
+        rest: (V, 3) float32 metres, the same body in the rest A-pose.
+        measurements: key ("A".."P") -> mm, of ``rest``.
+        spreads: key -> mm, the ± of each measurement (:mod:`bodyfit.fitter.fit.spreads`).
+        spread_basis: which ± ``spreads`` holds, one of ``spreads.SPREAD_BASES``.
+        views: the kernels' targets (canvas silhouettes and cameras), by view name.
+        seconds: stage -> wall seconds ("canvas", "search", "measure").
+        view_bodies: view name -> (V, 3) float32 metres, the best candidate as the search
+            scored it in that view (its pose with the view's fixed angles, e.g. the side
+            view's arms down; not rescaled to the stature): what the view's canvas shows.
+    """
+
+    search: SearchResult
+    posed: np.ndarray
+    rest: np.ndarray
+    measurements: dict[str, float]
+    spreads: dict[str, float]
+    spread_basis: str
+    views: dict[str, kernels.ViewTarget]
+    seconds: dict[str, float]
+    view_bodies: dict[str, np.ndarray]
+
+
+def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
+          view_options: dict) -> kernels.ViewTarget:
+    """One view's target with ``settings.projection`` (``intrinsics``: (3, 3) K for pinhole;
+    ``view_options``: the side view's arms,
+    :func:`~bodyfit.fitter.fit.side_arms.side_view_options`)."""
+    if settings.projection == "pinhole":
+        # placed from the mean body as the view renders it (the side view's arms hanging
+        # down: the hands reach in front of the body, and the placement's horizontal
+        # centre must see them as the photo does)
+        pose = np.zeros((1, len(POSE_NAMES)))
+        for joint, degrees in (view_options.get("fixed_pose_deg") or {}).items():
+            pose[0, POSE_NAMES.index(joint)] = degrees
+        posed_mean = forward(model, np.zeros((1, settings.search.components)), pose)[0]
+        return pinhole_view(name, mask, intrinsics, stature_m, extent, posed_mean,
+                            model.vertex_parts, settings.canvas, settings.device,
+                            **view_options)
+    return orthographic_view(name, mask, stature_m, extent, mean_body, settings.canvas,
+                             settings.device, **view_options)
+
+
+def person_views(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
+                 settings: FitSettings, intrinsics: dict[str, np.ndarray] | None,
+                 bodies: np.ndarray) -> dict[str, kernels.ViewTarget]:
+    """{"front": view, "side": view}: the targets a fit's search starts on (pinhole cameras
+    placed from the mean body), of :func:`fit_person`'s arguments; ``bodies``: the search's
+    extreme bodies (:func:`~bodyfit.fitter.fit.canvas.extreme_bodies` over
+    ``settings.search.components``), whose extent the canvases cover."""
+    s = settings.search
+    mean_body = forward(model, np.zeros((1, s.components)), np.zeros((1, 4)))[0]
+    # arms turned down in the frontal plane keep their side-view width and stay above
+    # the feet, so the extent of the search's pose range covers them
+    options = {"front": {}, "side": side_view_options(model, settings.side_arms)}
+    return {name: _view(name, masks[name], (intrinsics or {}).get(name), stature_m,
+                        bodies.reshape(-1, 3), mean_body, model, settings, options[name])
+            for name in ("front", "side")}
+
+
+def stature_conditioner(model: BodyModel, settings: FitSettings, stature_m: float,
+                        bodies: np.ndarray) -> StatureConditioner | None:
+    """The fit's :class:`~bodyfit.fitter.fit.stature.StatureConditioner` (None without
+    ``condition_stature``): on the rest stature, on the posed height for orthographic
+    canvases (scaled so that the person's silhouette is the stature tall). ``bodies``: the
+    search's extreme bodies (:func:`~bodyfit.fitter.fit.canvas.extreme_bodies`)."""
+    s = settings.search
+    if not s.condition_stature:
+        return None
+    return StatureConditioner(model, s.components, stature_m, s.beta_limit, bodies,
+                              posed=settings.projection == "orthographic")
+
+
+def _scoring(model: BodyModel, views: dict[str, kernels.ViewTarget], settings: FitSettings,
+             stature_m: float, bodies: np.ndarray):
+    """(the kernels' evaluator over ``views``, the stature conditioner or None) for the
+    ``settings.search.components`` of a candidate; ``bodies``: the search's extreme bodies
+    over those components."""
+    arrays = kernels.ModelArrays.from_body_model(render_model(model, settings.render_cell_mm),
+                                                 settings.search.components, settings.device)
+    evaluator = kernels.PopulationEvaluator(arrays, list(views.values()), settings.cost,
+                                           workers=settings.threads)
+    return evaluator, stature_conditioner(model, settings, stature_m, bodies)
+
+
+def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
+                   view: kernels.ViewTarget, stature_m: float,
+                   condition_stature: bool) -> np.ndarray:
+    """(V', 3) float64 metres: the body a pinhole view's camera is placed from
+    (:func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
+    (4,) degrees): the parts the view shows, in the view's pose, as the kernels render it.
+
+    A candidate conditioned on the stature (:mod:`bodyfit.fitter.fit.stature`) is taken as it
+    is: on the rest stature (pinhole views) it is the person's size. (Conditioned on the
+    posed height, it stands the stature tall with its legs apart, where the person stands a
+    few millimetres lower, so it is the person scaled by stature / (stature - delta) and
+    its camera must stand as much farther: scaled to the rest stature instead, the camera
+    stood at the person's distance and showed every candidate 0.2-0.7 % too tall, and the
+    search answered with bodies as much too thin; docs/accuracy.md, "Pushing the
+    numbers", step 11.) Without the conditioning a candidate has its own height, and the
+    camera is placed for it scaled to the person's stature.
+    """
+    body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
+    if not condition_stature:
+        body = body * stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
+    shown = visible_vertices(model.vertex_parts, view.visible_parts)
+    return body[shown].astype(np.float64)
+
+
+def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
+                  betas: np.ndarray, pose_deg: np.ndarray) -> None:
+    """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
+    degrees) as the kernels render it (:func:`placement_body`,
+    :func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`); updates ``views`` and the
+    evaluator."""
+    for name, view in views.items():
+        body = placement_body(model, betas, pose_deg, view, stature_m,
+                              settings.search.condition_stature)
+        views[name] = placed_anew(view, masks[name], intrinsics[name], body)
+        evaluator.replace_view(views[name])
+
+
+def _placement_rounds(model, views, masks, intrinsics, stature_m, evaluator, settings):
+    """The search's ``on_generation`` that places the pinhole cameras anew from the best
+    body so far (:func:`place_cameras`) after each of ``settings.placement_rounds``
+    evenly spaced generations."""
+    generations = settings.search.generations or 1
+    rounds = settings.placement_rounds
+    # never after the last generation: its best must be scored with the cameras it ends with
+    at = {g for g in (round(generations * (i + 1) / (rounds + 1)) for i in range(rounds))
+          if 1 <= g < generations}
+
+    def place(done: int, betas: np.ndarray, pose_deg: np.ndarray) -> bool:
+        if done not in at:
+            return False
+        place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
+                      betas, pose_deg)
+        return True
+
+    return place
+
+
+def _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner, settings,
+              progress) -> SearchResult:
+    """``settings.search.searches`` searches of the person (seeds ``seed``, ``seed + 1``,
+    ...), each from the views as ``views`` holds them (the cameras placed from the mean
+    body) with its own placement rounds; one search's result as it is, several averaged
+    (:func:`~bodyfit.fitter.fit.search.averaged`): the mean of their genes (the first beta
+    solved anew from the stature), scored with the cameras placed from that body. Updates
+    ``views`` (and the evaluator) to the cameras the answer is scored with."""
+    s = settings.search
+    placing = settings.projection == "pinhole" and settings.placement_rounds > 0
+    replace = (_placement_rounds(model, views, masks, intrinsics, stature_m, evaluator,
+                                 settings) if placing else None)
+    first_views = dict(views)
+    results = []
+    for i in range(s.searches):
+        views.update(first_views)  # each search starts from the mean body's cameras
+        for view in views.values():
+            evaluator.replace_view(view)
+        results.append(search(evaluator, dataclasses.replace(s, seed=s.seed + i), conditioner,
+                              progress, replace))
+    if len(results) == 1:
+        return results[0]
+    place = (functools.partial(place_cameras, model, views, masks, intrinsics, stature_m,
+                               evaluator, settings) if placing else None)
+    return _mean_of(results, evaluator, conditioner, place)
+
+
+def _mean_of(results: list[SearchResult], evaluator, conditioner, place=None) -> SearchResult:
+    """Several searches' results as one (:func:`~bodyfit.fitter.fit.search.averaged`): the mean
+    of their genes (the first beta solved anew from the stature when ``conditioner`` is
+    given), scored by ``evaluator`` after ``place(betas, pose)`` (None: the cameras as
+    they are) has placed its cameras from that body."""
+    pose = np.mean([r.pose_deg for r in results], axis=0)
+    betas = np.mean([r.betas for r in results], axis=0)
+    if conditioner is not None:
+        betas = conditioner.complete(betas[None, 1:], pose[None])[0]
+    if place is not None:
+        place(betas, pose)
+    scored = evaluator.evaluate(betas[None], pose[None])
+    return averaged(results, betas, pose, float(scored.costs[0]), scored.part_costs[0])
+
+
+def refinement_scoring(model: BodyModel, views: dict[str, kernels.ViewTarget],
+                       stature_m: float, settings: FitSettings):
+    """(evaluator, stature conditioner or None) of the refinement
+    (``settings.search.refinement()``: its ``refine_components``) over ``views``."""
+    s = settings.search
+    refinement = s.refinement()
+    bodies = extreme_bodies(model, refinement.components, s.pose_lower_deg, s.pose_upper_deg,
+                            settings.canvas.beta_limit)
+    return _scoring(model, views, dataclasses.replace(settings, search=refinement), stature_m,
+                    bodies)
+
+
+def _refined(model, views, stature_m, first: SearchResult, settings, progress) -> SearchResult:
+    """The refinement (``SearchSettings.refine_components``) of ``first``'s answer:
+    ``refinements`` searches (seeds ``seed``, ``seed + 1``, ...), each started from that
+    answer, with the cameras ``first`` left in ``views``, side by side
+    (:func:`~bodyfit.fitter.fit.search.searches_together`); several averaged by
+    :func:`_mean_of` (the cameras kept); joined to ``first`` by
+    :func:`~bodyfit.fitter.fit.search.refined`."""
+    refinement = settings.search.refinement()
+    evaluator, conditioner = refinement_scoring(model, views, stature_m, settings)
+    betas = np.r_[first.betas, np.zeros(refinement.components - len(first.betas))]
+    start = np.r_[betas[len(betas) - refinement.searched_betas:], first.pose_deg]
+    seeds = [dataclasses.replace(refinement, seed=refinement.seed + i)
+             for i in range(refinement.searches)]
+    results = searches_together(evaluator, seeds, conditioner, progress, start=start)
+    return refined(first, results[0] if len(results) == 1
+                   else _mean_of(results, evaluator, conditioner))
+
+
+def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
+                  views: dict[str, kernels.ViewTarget], stature_m: float,
+                  condition_stature: bool) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The fit's bodies of its answer (betas (K,), pose (4,) degrees), float32 metres:
+    (posed (V, 3), rest (V, 3), view name -> (V, 3) in that view's pose), the posed and
+    rest bodies rescaled to the stature when the search conditioned it (a posed height
+    conditioned, or a first beta at its limit), the view bodies as the search scored them."""
+    posed = forward(model, betas[None], pose_deg[None])[0]
+    view_bodies = {name: forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
+                   for name, view in views.items()}
+    rest = rest_shape(model, betas[None])[0][0]
+    if condition_stature:
+        scale = stature_scale(rest, stature_m)
+        posed, rest = posed * scale, rest * scale
+    return posed, rest, view_bodies
+
+
+def view_photos(settings: FitSettings, views: dict[str, kernels.ViewTarget],
+                view_bodies: dict[str, np.ndarray], masks: dict[str, np.ndarray],
+                intrinsics: dict[str, np.ndarray] | None) -> dict[str, ViewPhoto] | None:
+    """The photos the measurements take extents from (:mod:`bodyfit.fitter.fit.photo_extents`),
+    by view name, with the fitted body in each view's pose; None when the settings take
+    none (``photo_extents`` off, or orthographic views). Arguments as
+    :func:`fitted_measurements`'."""
+    if not (settings.photo_extents and settings.projection == "pinhole"):
+        return None
+    return {name: ViewPhoto(name, masks[name], intrinsics[name], view_bodies[name],
+                            view.visible_parts) for name, view in views.items()}
+
+
+def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSettings,
+                        rest: np.ndarray, view_bodies: dict[str, np.ndarray],
+                        views: dict[str, kernels.ViewTarget], masks: dict[str, np.ndarray],
+                        intrinsics: dict[str, np.ndarray] | None) -> dict[str, float]:
+    """key -> mm: the 16 measurements of the fitted ``rest`` body, those of
+    ``photo_extents.SCALED`` scaled to the photos (:func:`view_photos`); the other arguments as
+    :func:`fit_person`'s and :func:`fitted_bodies`' answers."""
+    measurements = measurer.measure(rest)
+    photos = view_photos(settings, views, view_bodies, masks, intrinsics)
+    if photos is not None:
+        measurements |= photo_scaled_measurements(model, measurer, rest, photos)
+    return measurements
+
+
+# One BLAS thread for the whole fit: its matrices are small (CMA-ES's 24 x 24, the
+# conditioner's, the forward's), and OpenBLAS's idle threads spin on the cores the
+# kernels' threads evaluate the population on (one fit: 22.5 -> 14.9 s with the search
+# alone limited; fitter batch, 2 workers: 17.6 -> 16.8 s with the whole fit limited).
+@threadpool_limits.wrap(limits=1, user_api="blas")
+def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
+               settings: FitSettings = FitSettings(), progress: bool | None = None,
+               intrinsics: dict[str, np.ndarray] | None = None) -> Fit:
+    """Fit the body model to a person's front and side silhouettes.
+
+    Args:
+        model: the body model.
+        masks: {"front": (H, W) bool, "side": (H', W') bool} silhouettes of the photos.
+        stature_m: the person's stature, metres (scales each view, Section 3.3).
+        settings: search, canvas, cost, device.
+        progress: show the search's progress bar (None: when stderr is a terminal).
+        intrinsics: {"front": K, "side": K}, (3, 3) pixels, of the upright photos the masks
+            are of; needed by the pinhole projection
+            (:func:`bodyfit.fitter.fit.person.view_intrinsics`).
+    """
+    settings.validate(model.num_components)
+    if settings.projection == "pinhole" and intrinsics is None:
+        raise ValueError("the pinhole projection needs the photos' intrinsics")
+    s = settings.search
+    t0 = time.perf_counter()
+    bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
+                            settings.canvas.beta_limit)
+    views = person_views(model, masks, stature_m, settings, intrinsics, bodies)
+    evaluator, conditioner = _scoring(model, views, settings, stature_m, bodies)
+    t1 = time.perf_counter()
+    result = _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner,
+                       settings, progress)
+    if s.refine_components:
+        result = _refined(model, views, stature_m, result, settings, progress)
+    t2 = time.perf_counter()
+    posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
+                                             stature_m, s.condition_stature)
+    measurer = Measurer.from_model(model)
+    measurements = fitted_measurements(model, measurer, settings, rest, view_bodies, views,
+                                       masks, intrinsics)
+    if calibration_applies(settings, METHODS["bodyfit"]):
+        spreads, basis = bodyfit_calibration().spreads(answer_cost(result)), "calibrated"
+    else:
+        spreads, basis = population_spreads(model, measurer, result, stature_m
+                                            if s.condition_stature else None), "population"
+    t3 = time.perf_counter()
+    return Fit(result, posed, rest, measurements, spreads, basis, views,
+               {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies)
+
+
+def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = FitSettings(),
+               progress: bool | None = None) -> Fit:
+    """:func:`fit_person` of a person's inputs: their photos' silhouettes (or their own
+    masks) and, through a pinhole camera, the photos' intrinsics.
+
+    Raises:
+        UserError: the inputs' problems (:func:`~bodyfit.fitter.fit.person.person_masks`).
+    """
+    masks = person_masks(inputs)
+    intrinsics = view_intrinsics(inputs, masks) if settings.projection == "pinhole" else None
+    return fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics)
