@@ -3,7 +3,7 @@
     python -m bench.batch_speed --docs docs/batch.md     # the figures of docs/batch.md
     python -m bench.batch_speed --subjects 2 --generations 2 --engines local   # a smoke run
 
-In-space subjects (:func:`bench_subjects.draw_subject`, photographed orthographically by
+In-space subjects (:func:`bench.subjects.draw_subject`, photographed orthographically by
 :mod:`bodyfit.fitter.demo.studio_photos`) are fitted by the `fitter batch` command itself at
 the paper's budget (``--method paper``: its GA, 30 x 25 candidates), once per engine
 (local processes, a local Ray instance started by the command) and worker count, each
@@ -114,7 +114,8 @@ def markdown(runs: list[dict], args, candidates: str) -> list[str]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m bench.batch_speed",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("--subjects", type=int, default=8)
     parser.add_argument("--seed", type=int, default=11)
     parser.add_argument("--workers", default="1,2", help="worker counts (default 1,2)")

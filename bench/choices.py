@@ -69,7 +69,8 @@ def _true_cost(model, fit, settings: FitSettings, betas, pose, stature_m) -> flo
 
 def main() -> None:
     warp.config.log_level = warp.LOG_WARNING  # no initialisation banner in the Markdown
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m bench.choices",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("--subjects", type=int, default=4)
     parser.add_argument("--seed", type=int, default=7)
     parser.add_argument("--generations", type=int, default=150)

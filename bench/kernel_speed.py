@@ -101,7 +101,8 @@ def _distance_errors(model, views, population) -> tuple[float, float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m bench.kernel_speed",
+                                     description=__doc__.split("\n\n")[0])
     parser.add_argument("--device", default="cpu", help="cpu, cuda or cuda:N")
     parser.add_argument("--populations", type=int, nargs="+", default=[30, 256, 1024])
     parser.add_argument("--height", type=int, default=512, help="image height, pixels")

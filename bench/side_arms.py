@@ -51,7 +51,8 @@ KEYS = ("D", "E", "F")
 
 def main() -> None:
     warp.config.log_level = warp.LOG_WARNING  # no initialisation banner in the Markdown
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m bench.side_arms",
+                                     description=__doc__.splitlines()[0])
     parser.add_argument("--subjects", type=int, default=4)
     parser.add_argument("--seed", type=int, default=7, help="subjects' seed")
     parser.add_argument("--population", type=int, default=30)

@@ -1,8 +1,8 @@
 """What the fitter benchmarks share: drawing in-space subjects, fitting them by command,
 their errors' table cells.
 
-Imported by the tools/bench_*.py scripts (run as ``python tools/bench_X.py``, which puts
-this folder on the import path).
+Imported by :mod:`bench.fitter_speed`, :mod:`bench.choices`, :mod:`bench.cameras`,
+:mod:`bench.side_arms` and :mod:`bench.batch_speed`.
 """
 
 from __future__ import annotations

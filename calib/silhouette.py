@@ -30,15 +30,15 @@ subtraction and shadow detection", 1999):
    first outline 2-3 px outside the edge, so one pass still takes the local person
    colour partly from mixed pixels; on the accuracy benchmark's JPEG photos it left the
    outline 0.24 px outside the exact one on average, four passes leave 0.05 px
-   (docs/accuracy.md, "Pushing the numbers"). Where no backdrop pixel lies in a pixel's
+   (docs/history.md). Where no backdrop pixel lies in a pixel's
    window (a gap between fingers, which the low threshold fills), the
    modelled backdrop colour of step 1 stands for the local one, and each pass carves
    ``outline_band_px`` further into such a gap: eight passes reopen the gaps between
    the fingers that four left filled, which made the hands look larger and the fitted
-   arms longer (docs/accuracy.md, step 35). A pixel must be half person also against
+   arms longer (docs/history.md, [35]). A pixel must be half person also against
    the colour two pixels inside the outline: a limb shaded darker at its outline than
    further in had its edge pixels taken for more person than they are, its outline a
-   fifth of a pixel wide of the truth on the benchmark's wrists (step 38).
+   fifth of a pixel wide of the truth on the benchmark's wrists (docs/history.md [38]).
 5. Enclosed holes smaller than ``max_hole_fraction`` of the person are filled (larger
    ones are real gaps, e.g. between an arm and the body with a hand on the hip).
 

@@ -1,4 +1,4 @@
-"""What the front photo's limb bends do to the photo readings (docs/accuracy.md, step 46).
+"""What the front photo's limb bends do to the photo readings (docs/history.md, [46]).
 
 The out-of-space bodies swing each limb forward or back in the front photo
 (:func:`~bench.accuracy.bodies.flexion_rotations`, about the model's x axis),

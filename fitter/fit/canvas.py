@@ -49,9 +49,9 @@ class CanvasSettings:
         body_height_px: the person's height on the canvas, pixels. 600 (bodyfit's
             default): about a phone photo's own resolution of a person 2.5-3.5 m away;
             on the accuracy benchmark's first 10 in-space subjects 400 missed the 7
-            important measurements by 5.1 mm, 600 and 800 by 3.6 (docs/accuracy.md,
-            "Pushing the numbers"). The paper's canvases are 512 px high
-            (:data:`PAPER_CANVAS`: 400 px of body leaves room for taller candidates).
+            important measurements by 5.1 mm, 600 and 800 by 3.6 (docs/history.md). The
+            paper's canvases are 512 px high (:data:`PAPER_CANVAS`: 400 px of body leaves
+            room for taller candidates).
         margin_px: free pixels around the largest candidate.
         beta_limit: shape coefficients span +-this many standard deviations.
     """

@@ -218,9 +218,9 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     few millimetres lower, so it is the person scaled by stature / (stature - delta) and
     its camera must stand as much farther: scaled to the rest stature instead, the camera
     stood at the person's distance and showed every candidate 0.2-0.7 % too tall, and the
-    search answered with bodies as much too thin; docs/accuracy.md, "Pushing the
-    numbers", step 11.) Without the conditioning a candidate has its own height, and the
-    camera is placed for it scaled to the person's stature.
+    search answered with bodies as much too thin; docs/history.md, [11].) Without the
+    conditioning a candidate has its own height, and the camera is placed for it scaled to
+    the person's stature.
     """
     body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
     if not condition_stature:

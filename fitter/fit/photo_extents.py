@@ -3,9 +3,9 @@
 The silhouette fit places each outline of the body to about a canvas pixel (at 600 px a
 pixel is the stature over 600, some 3 mm), and where the model cannot follow the person
 everywhere at once it compromises: out-of-space the neck's section came out 2.7 mm too
-wide or narrow on average, its circumference 7.9 mm off (docs/accuracy.md, "Pushing the
-numbers", steps 26 and 28). The photo itself shows that width at its own resolution. So
-for the girths of :data:`PHOTO_EXTENTS`, after the fit, each listed view's photo is
+wide or narrow on average, its circumference 7.9 mm off (docs/history.md, [26] and [28]).
+The photo itself shows that width at its own resolution. So for the girths of
+:data:`PHOTO_EXTENTS`, after the fit, each listed view's photo is
 compared with the fitted body rendered through the same camera at the photo's resolution:
 the ratio of the person's outline width to the body's, averaged over the lines along the
 tape around its centre, scales the fitted section along that view's silhouette axis
@@ -53,20 +53,20 @@ scaled the same way, by the front photo's outline width across the deltoids
   the jaw's underside, lower than the fitted body's, reached into the side photo's tape
   rows, their ratios 1.12-1.25 where the truth's depth over the fit's is 0.99, and the
   neck came out 36 mm large; the other 107 neck readings of 54 fits spread 0.07 at
-  most: docs/accuracy.md, step 36), or, for the neck, where the rendered outline's sides
+  most: docs/history.md, [36]), or, for the neck, where the rendered outline's sides
   lean further from upright than :data:`MAX_OUTLINE_LEAN_DEG` across the band (the
   tape's rows lie on the neck's flare into the shoulders: there a row's width reads the
   slope's height, not the section, and an offset of a row between the person and the
   body changes it by twice the lean's tangent; on a short-necked subject of the hard
   share the front photo read 1.19 where the truth's width over the fit's is 1.04, and
-  the neck came out 47 mm large: step 37).
+  the neck came out 47 mm large: docs/history.md [37]).
 - Which measurements and views: chosen by measured error (docs/accuracy.md steps
   28-32 and 43): the head's width from the front photo and its depth from the side photo
   (its tape horizontal; hair, which the benchmark's subjects lack, would widen both and
   the girth with them, within :data:`MAX_CHANGE`), the neck's, the chest's, the waist's
   and the hip's width from the front photo, the chest's and the waist's depth from the
-  side photo (step 43: on the choice rows' fits the chest 5.43 -> 4.81 mm out-of-space,
-  1.75 -> 1.69 in-space; the waist 3.50 -> 3.37 and 1.91 -> 1.76),
+  side photo (docs/history.md [43]: on the choice rows' fits the chest 5.43 -> 4.81 mm
+  out-of-space, 1.75 -> 1.69 in-space; the waist 3.50 -> 3.37 and 1.91 -> 1.76),
   the neck's depth from the side photo along its tilted tape, the shoulder breadth from
   the front photo 2 cm below the acromions (at them the outline is the shoulders'
   rounded top; 2 cm came out better than 1 cm above, 0 or 4 cm below on the same fits),
@@ -75,9 +75,9 @@ scaled the same way, by the front photo's outline width across the deltoids
   some 30 degrees off the section's first; the wrist's tape lies where the thumb starts,
   and read there it lost on both sets: 3 cm up the forearm came out better than 1.5 or
   4.5), the calf's and the ankle's width from the front photo (the A-pose's legs stand
-  apart; step 32). The hip's side depth is not read: the side photo's hands hang at its
-  tape (:data:`_OWN_PARTS` refused 93 of 104 choice fits' readings; the other 11 moved
-  its mean error by 0.02 mm at most); the side photo's arms hang against the body and
+  apart; docs/history.md [32]). The hip's side depth is not read: the side photo's hands
+  hang at its tape (:data:`_OWN_PARTS` refused 93 of 104 choice fits' readings; the other
+  11 moved its mean error by 0.02 mm at most); the side photo's arms hang against the body and
   its legs overlap; the thigh's front width lost out-of-space (at the gluteal fold the
   outline's outer end is the buttock's), so the thigh is not scaled.
 
@@ -119,7 +119,7 @@ PHOTO_EXTENTS = {"A": ("front", "side"), "B": ("front", "side"), "D": ("front", 
 #: bicep's. No photo shows the upper arm's depth (the side photo's arm hangs against the
 #: body), and an arm fitted too thin or too thick is so both ways: on the out-of-space
 #: choice rows its mean error 3.79 -> 2.97 mm, where the forearm's, the wrist's, the
-#: calf's and the ankle's lost 0.7-1.0 mm each so (docs/accuracy.md, step 41).
+#: calf's and the ankle's lost 0.7-1.0 mm each so (docs/history.md, [41]).
 WHOLE_SECTION = ("H.L", "H.R")
 #: The measurements (MEASUREMENTS keys) the photos scale: a tape key's part before its
 #: ".L"/".R".

@@ -15,7 +15,7 @@ vertices (no landmarks): the kernels render and score it; the fitted body, its
 measurements and the pictures use the full model. At 8 mm: 19,900 triangles, 9,874
 vertices; the kernels' speed: docs/fitter.md, "Speed".
 
-The hands (6,380 triangles) were clustered too until docs/accuracy.md's step 34: a hand
+The hands (6,380 triangles) were clustered too until docs/history.md [34]: a hand
 of 8 mm cubes reaches about 1 mm less far than the model's, which the fits paid for with
 longer arms (the arm length's error in-space 3.10 -> 2.59 mm with the hands left whole).
 """

@@ -26,8 +26,8 @@ __all__ = ["SearchSettings", "SearchResult", "search", "searches_together", "ave
 #: The refinement's initial step (``SearchSettings.refine_components``), a fraction of every
 #: gene's range: 0.5 sd of a beta, 3 degrees of an angle (on the first 20 out-of-space
 #: subjects, 0.05 for 100 generations gained 0.2 mm, 0.08 for 250 gained 2.0:
-#: docs/accuracy.md, step 14; two refinements at 0.04 against 0.08 on the first 40 of each
-#: set: -0.42 mm in-space, +0.15 out-of-space, step 16).
+#: docs/history.md, [14]; two refinements at 0.04 against 0.08 on the first 40 of each
+#: set: -0.42 mm in-space, +0.15 out-of-space, [16]).
 REFINE_SIGMA0 = 0.08
 
 
@@ -58,7 +58,7 @@ class SearchSettings:
             whose answers the fit averages (:func:`averaged`; the paper: 1). One search's
             answer varies with its seed by about as much as its error (its cost's noise
             floor is flat across millimetres of shape), so the mean of two is nearer the
-            truth (docs/accuracy.md, "Pushing the numbers", step 13).
+            truth (docs/history.md, [13]).
         refine_components: K' > K: after the searches, ``refinements`` more searches
             (CMA-ES's, seeds ``seed``, ``seed + 1``, ...) over the first K' components and
             the angles, each started from the searches' answer (the components past K at
@@ -67,19 +67,19 @@ class SearchSettings:
             cannot (with K = 20, 7.1 mm of the 7 important measurements of real bodies).
             One refinement alone varies with its seed by about its error; two averaged
             gained 2.0 mm out-of-space and lost 0.6 in-space (200 subjects of each set),
-            four gained 0.4 mm more in each set (the first 40; docs/accuracy.md, "Pushing
-            the numbers", steps 14-16). 0: none (the paper).
+            four gained 0.4 mm more in each set (the first 40; docs/history.md, [14-16]).
+            0: none (the paper).
         refine_generations: each refinement's generations. 500 against 250: -0.25 mm
             in-space and -0.67 out-of-space on 20 subjects of each set, for 1.6x the
             time; the refinements converge (cma stops) by about 900, 750 gained 0.1 mm
-            more out-of-space only (docs/accuracy.md, step 19).
+            more out-of-space only (docs/history.md, [19]).
         refinements: how many refinements are averaged. Their answers scatter about the
             body the silhouettes fix, each by about its error (the cost is flat across
             millimetres of shape), so their mean is nearer: four against two, -0.42 mm
             in-space and -0.40 out-of-space on the first 40 subjects of each set
-            (docs/accuracy.md, step 16); six against four, -0.18 +- 0.11 mm over 54
+            (docs/history.md, [16]); six against four, -0.18 +- 0.11 mm over 54
             subjects of both sets, each subject's own fits, for 1.43x the candidates
-            (steps 24-27).
+            ([24]-[27]).
     """
 
     optimizer: str = "cmaes"

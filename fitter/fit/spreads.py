@@ -9,9 +9,10 @@ Two kinds (``SPREAD_BASES``):
   that on the accuracy benchmark's out-of-space subjects (full Anny bodies photographed
   through a phone camera: the benchmark's stand-in for real people) the truth lay within
   the ± for 68.3 % of the subjects, each measurement (one standard deviation's share of
-  a normal error); they come from ``bench/accuracy/cli.py spread`` on the default's
-  88 held-out out-of-space fits (docs/accuracy.md, step 42: made from half of them, the
-  ± held the truth for 67.7 % of the other half's measurements, each half in turn). The
+  a normal error); they come from ``python -m bench.accuracy spread`` on the default's
+  88 held-out out-of-space fits (docs/accuracy.md, "The protocol": made from half of
+  them, the ± held the truth for 67.7 % of the other half's measurements, each half in
+  turn). The
   cost scales the ± because a body the model's space cannot reproduce leaves its
   silhouettes matched worse: the in-space subjects' answer costs are about three fifths of
   the out-of-space ones', their errors smaller still. Real photos (clothes, hair, a

@@ -20,8 +20,7 @@ height, and the search is over the shape's other components and the pose. Which 
 
 Conditioning on the posed height in pinhole views too (the default before) left every
 candidate 0.2-0.7 % taller than the person and changed its shape along the first
-component to get there; on the rest stature the in-space error fell (docs/accuracy.md,
-"Pushing the numbers", step 13).
+component to get there; on the rest stature the in-space error fell (docs/history.md, [13]).
 
 The vertices are linear in the betas for a fixed pose (Eq. 1-3 with the rotations
 fixed), so a height is piecewise linear in the first beta; Newton steps on the vertices

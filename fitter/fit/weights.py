@@ -32,7 +32,7 @@ Presets (``PRESETS``):
   defaults"). The head and neck at 4, paired with 2 on 23 out-of-space subjects: the
   head circumference's error 5.3 -> 2.8 mm (-2.4 +- 1.7, better for 18), the 7 important
   measurements' mean -0.15 +- 0.57 mm; in-space (19 subjects) no change shown
-  (docs/accuracy.md, steps 22-23).
+  (docs/history.md, [22-23]).
 - ``uniform``: every name 1: the paper's equal-coefficients run of Fig. 17, which it
   shows to be less accurate than Table 2's (Fig. 16).
 - ``lower-body``: for trousers: hip 8, leg 6, waist 5, foot 2, top 5, bottom 5 (the

@@ -94,7 +94,7 @@ def test_the_gaps_between_fingers_stay_open():
     # The low threshold joins two fingers' mixed edge pixels across a narrow gap, where
     # no backdrop pixel is near to tell the refinement the backdrop's colour; filled, the
     # gaps made the benchmark's hands look larger and its fitted arms longer
-    # (docs/accuracy.md, step 35).
+    # (docs/history.md, [35]).
     coverage, hull = _fanned_fingers()
     photo = (1.0 - coverage[..., None]) * np.asarray(BACKDROP, np.float32) \
         + coverage[..., None] * np.asarray(SKIN, np.float32)

@@ -233,7 +233,7 @@ def test_placement_rounds_place_the_camera_for_the_body_as_rendered(body_model, 
     silhouette. One conditioned on the posed height stands the stature tall with its legs
     apart, the person about 2 cm lower (12 degrees apart): placed from it as rendered, the
     camera shows it as tall as the person too; placed from it scaled to the rest stature
-    (the person's own size, as before step 11), it showed it 1 % too tall."""
+    (the person's own size, as before docs/history.md [11]), it showed it 1 % too tall."""
     pose = np.array([5.0, 5.0, 12.0, 12.0])
     truth = write_pinhole_subject(tmp_path, body_model, SUBJECT_BETAS, pose, K_TRUE, SIZE_PX,
                                   3.0, 1.2)
