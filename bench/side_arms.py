@@ -34,8 +34,8 @@ import warp
 
 from bench.subjects import draw_subject
 from bodyfit.fitter.demo.studio_photos import write_subject
-from bodyfit.fitter.fit.person import PersonInputs, person_masks
-from bodyfit.fitter.fit.person_fit import FitSettings, fit_person
+from bodyfit.fitter.fit.person import PersonInputs
+from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
 from bodyfit.fitter.fit.search import SearchSettings
 from bodyfit.fitter.measure.measurements import IMPORTANT
 from bodyfit.fitter.model.cache import load_model
@@ -75,9 +75,9 @@ def main() -> None:
                 inputs = PersonInputs(str(folder / "front.png"), str(folder / "side.png"),
                                       truth["O"] / 10)
                 start = time.perf_counter()
-                fit = fit_person(model, person_masks(inputs), truth["O"] / 1000,
-                                 FitSettings(search=search, side_arms=fit_arms,
-                                             projection="orthographic"), progress=False)
+                fit = fit_inputs(model, inputs, FitSettings(search=search, side_arms=fit_arms,
+                                                            projection="orthographic"),
+                                 progress=False)
                 seconds[name].append(time.perf_counter() - start)
                 errors[name].append({k: fit.measurements[k] - truth[k] for k in truth})
     print(f"`python -m bench.side_arms --subjects {args.subjects} --seed {args.seed} "

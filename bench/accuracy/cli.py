@@ -58,8 +58,7 @@ from bench.accuracy.figures import (colour_bar, distance_panel, errors_per_gener
                                     fitted_rest_body)
 from bench.accuracy.report import (failure_lines, important_table, measurement_table,
                                    paired_measurement_table)
-from bench.accuracy.runs import (concatenated, joined_scores, keep_run, read_source,
-                                 source_timing, subset)
+from bench.accuracy.runs import concatenated, joined_scores, keep_run, source_timing, subset
 from bench.accuracy.scores import KEYS, RunScores
 from bench.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
                                         read_settings, subject_ids, write_bodies,
@@ -188,11 +187,8 @@ def keep(args) -> None:
     if not (run / SUMMARY_FILE).exists():
         sys.exit(f"{run}: no {SUMMARY_FILE} (not a run of fitter batch)")
     kept = Path(args.to) / read_settings(folder).kind / f"{args.setting or args.name}.csv"
-    scores = read_source(run)
-    held = scores.ids + [s for s, _ in scores.failures]
-    truths = {s: json.loads((folder / s / "truth.json").read_text()) for s in held}
     try:
-        count = keep_run(run, truths, kept)
+        count = keep_run(run, kept)
     except ValueError as error:
         sys.exit(f"keep: {error}")
     print(f"{run} -> {kept}: {count} subjects")

@@ -15,7 +15,7 @@ import numpy as np
 
 from bodyfit import kernels
 from bodyfit.fitter.fit.canvas import extreme_bodies
-from bodyfit.fitter.fit.person import PersonInputs, person_masks, view_intrinsics
+from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
 from bodyfit.fitter.fit.person_fit import (FitSettings, fitted_bodies, fitted_measurements,
                                            person_views, view_photos)
 from bodyfit.fitter.fit.photo_extents import ViewPhoto
@@ -63,8 +63,7 @@ class FitPhotos:
         inputs = PersonInputs(**given | {
             view: str(folder / subject / Path(given[view]).name) for view in ("front", "side")}
             | ({"camera": str(folder / Path(given["camera"]).name)} if given["camera"] else {}))
-        masks = person_masks(inputs)
-        intrinsics = view_intrinsics(inputs, masks) if settings.projection == "pinhole" else None
+        masks, intrinsics = person_silhouettes(inputs, settings.projection)
         s = settings.search
         stature_m = inputs.height_cm / 100.0
         views = person_views(model, masks, stature_m, settings, intrinsics,

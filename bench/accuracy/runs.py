@@ -192,10 +192,10 @@ def _number(value) -> str:
     return "" if value is None or value != value else repr(float(value))
 
 
-def keep_run(run: Path, truths: dict[str, dict], kept: Path) -> int:
-    """Merge the subjects of ``run`` into the kept setting ``kept`` (a .csv), replacing its
-    rows of the same subjects, and their ``truths`` (``{id: truth.json record}``) into the
-    truths.csv beside it; rows in the set's order. Returns the subjects kept.
+def keep_run(run: Path, kept: Path) -> int:
+    """Merge the subjects of ``run`` (a run folder, its set two folders up) into the kept
+    setting ``kept`` (a .csv), replacing its rows of the same subjects, and their truths
+    into the truths.csv beside it; rows in the set's order. Returns the subjects kept.
 
     Raises:
         ValueError: a truth differs from the one kept already (another set's subject).
@@ -205,12 +205,11 @@ def keep_run(run: Path, truths: dict[str, dict], kept: Path) -> int:
                        "reason": ""} for row in rows}
     new.update({subject: {"id": subject, "status": "failed", "reason": reason}
                 for subject, reason in failures})
-    table = {row["id"]: row for row in (read_table(kept, KEPT_COLUMNS) if kept.exists() else [])}
+    table = {row["id"]: row for row in read_table(kept, KEPT_COLUMNS)}
     table.update(new)
     truth_path = kept.parent / TRUTHS_FILE
-    known = {row["id"]: row for row in (read_table(truth_path, TRUTH_COLUMNS)
-                                        if truth_path.exists() else [])}
-    for subject, record in truths.items():
+    known = {row["id"]: row for row in read_table(truth_path, TRUTH_COLUMNS)}
+    for subject, record in _set_truths(run.parents[1], list(new)).items():
         row = {"id": subject, "sex": record["sex"], "hard": str(bool(record["hard"])),
                **{f"{name}_mm": repr(float(record["measurements"][key]))
                   for key, name in zip(KEYS, _NAMES)}}

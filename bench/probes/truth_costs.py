@@ -26,7 +26,7 @@ import cma
 import numpy as np
 
 from bodyfit.fitter.fit.canvas import extreme_bodies
-from bodyfit.fitter.fit.person import person_masks, view_intrinsics
+from bodyfit.fitter.fit.person import person_silhouettes
 from bodyfit.fitter.fit.person_fit import person_views, place_cameras, refinement_scoring
 from bodyfit.fitter.model.body_model import PART_NAMES, POSE_NAMES, BodyModel, project_shape
 from bodyfit.fitter.run.config import run_config
@@ -68,9 +68,7 @@ def compare_costs(model: BodyModel, run_json: Path, vertices: np.ndarray,
     record = json.loads(Path(run_json).read_text())
     config = run_config(record, str(run_json))
     settings, inputs, result = config.settings, config.inputs, record["result"]
-    masks = person_masks(inputs)
-    intrinsics = (view_intrinsics(inputs, masks) if settings.projection == "pinhole"
-                  else None)
+    masks, intrinsics = person_silhouettes(inputs, settings.projection)
     stature_m = inputs.height_cm / 100.0
     s = settings.search
     if not s.refine_components:  # score in the search's own space

@@ -19,7 +19,8 @@ from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
 from bodyfit.fitter.fit.pinhole_canvas import phone_intrinsics, upright_intrinsics
 
-__all__ = ["PersonInputs", "STATURE_RANGE_CM", "person_masks", "view_intrinsics"]
+__all__ = ["PersonInputs", "STATURE_RANGE_CM", "person_masks", "view_intrinsics",
+           "person_silhouettes"]
 
 #: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
 #: most likely given in other units).
@@ -118,3 +119,15 @@ def view_intrinsics(inputs: PersonInputs, masks: dict[str, np.ndarray]) -> dict[
                             f"the upright photo of the camera is {size[1]}x{size[0]}")
         found[view] = k
     return found
+
+
+def person_silhouettes(inputs: PersonInputs, projection: str
+                       ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray] | None]:
+    """(:func:`person_masks`, and :func:`view_intrinsics` for the ``"pinhole"`` projection,
+    else None): what a fit takes of the person's photos.
+
+    Raises:
+        UserError: as :func:`person_masks` and :func:`view_intrinsics`.
+    """
+    masks = person_masks(inputs)
+    return masks, view_intrinsics(inputs, masks) if projection == "pinhole" else None

@@ -17,7 +17,7 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
                                        orthographic_view)
-from bodyfit.fitter.fit.person import PersonInputs, person_masks, view_intrinsics
+from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
 from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew
 from bodyfit.fitter.fit.render_mesh import render_model
@@ -33,9 +33,8 @@ from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, forward, rest
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fitted_bodies",
-           "fitted_measurements",
-           "person_views", "place_cameras", "placement_body", "refinement_scoring",
-           "stature_conditioner", "view_photos"]
+           "fitted_measurements", "person_views", "place_cameras", "placement_body",
+           "refinement_scoring", "stature_conditioner", "view_photos"]
 
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
@@ -434,8 +433,8 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
     masks) and, through a pinhole camera, the photos' intrinsics.
 
     Raises:
-        UserError: the inputs' problems (:func:`~bodyfit.fitter.fit.person.person_masks`).
+        UserError: the inputs' problems
+            (:func:`~bodyfit.fitter.fit.person.person_silhouettes`).
     """
-    masks = person_masks(inputs)
-    intrinsics = view_intrinsics(inputs, masks) if settings.projection == "pinhole" else None
+    masks, intrinsics = person_silhouettes(inputs, settings.projection)
     return fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics)
