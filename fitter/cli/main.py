@@ -34,13 +34,14 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
         parser.add_argument("--config", type=Path, metavar="run.json",
                             help="repeat a previous run: its inputs and settings from its "
                                  "run.json (the options given here override them)")
-    parser.add_argument("--method", choices=("bodyfit", "paper"),
-                        help="bodyfit (default: CMA-ES 30 x 150, stature-conditioned "
-                             "candidates, model-to-person matching, bodyfit weights, the "
-                             "camera placed anew from the best body) or paper (the "
-                             "paper's method exactly: its GA 30 x 25, Table 2 weights, "
-                             "person-to-model matching); the options below override single "
-                             "settings")
+    parser.add_argument("--method", choices=("bodyfit", "thorough", "paper"),
+                        help="bodyfit (default: the local solver from the mean body, "
+                             "stature-conditioned, bodyfit weights, the camera solved with "
+                             "the body), thorough (the population search that was the "
+                             "default before: CMA-ES, 99,000 candidates, minutes a person) "
+                             "or paper (the paper's method exactly: its GA 30 x 25, Table 2 "
+                             "weights, person-to-model matching); the options below override "
+                             "single settings")
     if not batch:
         parser.add_argument("--front", metavar="PHOTO", help="front photo, A-pose (required "
                             "without --config)")
@@ -105,8 +106,12 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     parser.add_argument("--seed", type=int, help="random seed (default 0)"
                         + ("; every subject uses it" if batch else ""))
     parser.add_argument("--searches", type=int,
-                        help="independent searches (seeds SEED, SEED+1, ...) whose answers "
-                             "are averaged (default 2; --method paper: 1)")
+                        help="independent population searches (seeds SEED, SEED+1, ...) whose "
+                             "answers are averaged (default 0: none, the local solver starts "
+                             "from the mean body; --method thorough: 2, paper: 1)")
+    parser.add_argument("--iterations", type=int,
+                        help="the local solver's iterations at most, after the searches "
+                             "(default 40; 0: none; --method thorough and paper: 0)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
                              "first K components, --refinements of them, averaged (more "
@@ -171,9 +176,8 @@ def _build_parser() -> argparse.ArgumentParser:
                            "are replaced)")
     demo.add_argument("--seed", type=int, default=0,
                       help="which body, camera place and board poses are drawn (default 0)")
-    demo.add_argument("--generations", type=int, metavar="G",
-                      help="the searches' and the refinements' generations (default: "
-                           "fitter run's)")
+    demo.add_argument("--method", choices=("bodyfit", "thorough", "paper"),
+                      help="fitter run's --method (default bodyfit)")
 
     run = sub.add_parser(
         "run", help="fit the body model to a person's front and side photos: mesh (m), "
@@ -276,12 +280,11 @@ def _cmd_demo(args) -> None:
 
     from bodyfit.fitter.demo.example import (DemoSettings, calibrate_scene, measurement_table,
                                              write_scene)
+    from bodyfit.fitter.fit.person_fit import fit_work
     from bodyfit.fitter.fit.spreads import SPREAD_NOTES
     from bodyfit.fitter.model.cache import load_model
     from bodyfit.fitter.run.results import run_person
 
-    if args.generations is not None and args.generations < 1:
-        raise UserError(f"--generations must be at least 1, got {args.generations}")
     model = load_model()
     scene = write_scene(model, args.output, DemoSettings(seed=args.seed))
     calibration, camera_path, coverage_path = calibrate_scene(scene)
@@ -294,17 +297,15 @@ def _cmd_demo(args) -> None:
     run_argv = ["run", "--front", str(scene.front), "--side", str(scene.side),
                 "--height-cm", f"{scene.truth['O'] / 10:.1f}", "--camera", str(camera_path),
                 "-o", str(args.output / "fit"), "--overwrite"]
-    if args.generations is not None:
-        run_argv += ["--generations", str(args.generations),
-                     "--refine-generations", str(args.generations)]
+    if args.method is not None:
+        run_argv += ["--method", args.method]
     run_args = _build_parser().parse_args(run_argv)
     inputs, settings, output = _run_settings(run_args)
     fit, written = run_person(model, inputs, settings, output, run_args.overwrite,
                               progress=None if not args.quiet else False)
     result = fit.search
-    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {result.evaluations} candidates, "
-          f"{result.generations} generations ({settings.search.optimizer}, "
-          f"{settings.projection})")
+    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {fit_work(settings, result)}, "
+          f"{settings.projection}")
     print("\n".join(measurement_table(fit.measurements, fit.spreads, scene.truth)))
     print(f"  ({SPREAD_NOTES[fit.spread_basis]})")
     print("wrote:")
@@ -340,6 +341,7 @@ def _run_settings(args):
 
 
 def _cmd_run(args) -> None:
+    from bodyfit.fitter.fit.person_fit import fit_work
     from bodyfit.fitter.fit.spreads import SPREAD_NOTES
     from bodyfit.fitter.measure.measurements import MEASUREMENTS
     from bodyfit.fitter.model.cache import load_model
@@ -353,8 +355,8 @@ def _cmd_run(args) -> None:
     except ValueError as exc:  # the kernels' argument and device errors, --matching
         raise UserError(str(exc)) from None
     result = fit.search
-    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {result.evaluations} candidates, "
-          f"{result.generations} generations, best cost {result.cost:.1f} weighted mm")
+    print(f"fitted in {sum(fit.seconds.values()):.1f} s: {fit_work(settings, result)}, "
+          f"cost {result.cost:.1f} weighted mm")
     for key, (_, label) in MEASUREMENTS.items():
         print(f"  {key} {label:<28} {fit.measurements[key]:8.1f} ± "
               f"{fit.spreads[key]:5.1f} mm")

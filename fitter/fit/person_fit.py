@@ -17,6 +17,7 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
                                        orthographic_view)
+from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
 from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew
@@ -32,7 +33,7 @@ from bodyfit.fitter.measure.measurements import Measurer
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, forward, rest_shape
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fitted_bodies",
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fit_work", "fitted_bodies",
            "fitted_measurements", "person_views", "place_cameras", "placement_body",
            "refinement_scoring", "stature_conditioner", "view_photos"]
 
@@ -41,7 +42,10 @@ class FitSettings:
     """Everything about a fit but the person.
 
     Attributes:
-        search: optimiser and space.
+        search: the population search (optimiser and space); ``searches`` 0: none, the
+            local solver starts from the mean body.
+        solver: the local solver (:mod:`bodyfit.fitter.fit.local_solver`), run after the
+            search from its answer (``iterations`` 0: none).
         canvas: canvas geometry.
         cost: the kernels' weights, matching and alignment (default: the ``bodyfit``
             weights preset, model -> person matching, the vertical anchor on the
@@ -68,7 +72,8 @@ class FitSettings:
             measurement is the fitted mesh's.
     """
 
-    search: SearchSettings = SearchSettings()
+    search: SearchSettings = SearchSettings(searches=0, refine_components=0)
+    solver: SolverSettings = SolverSettings(iterations=40)
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="model_to_person",
@@ -85,6 +90,9 @@ class FitSettings:
         """Raise UserError for settings no person could be fitted with (one line, naming
         the option)."""
         self.search.validate(stored_components)
+        self.solver.validate(stored_components)
+        if not (self.search.searches or self.solver.iterations):
+            raise UserError("--searches 0 needs the local solver (--iterations 1 or more)")
         self.canvas.validate()
         if self.threads is not None and self.threads < 1:
             raise UserError(f"--threads must be at least 1, got {self.threads}")
@@ -97,16 +105,21 @@ class FitSettings:
             raise UserError(f"placement_rounds must be >= 0, got {self.placement_rounds}")
 
 
-#: The methods of ``fitter run --method``: bodyfit's defaults (chosen by measured error,
-#: docs/fitter.md "Choosing the defaults") and the paper's method exactly (Sections
-#: 3.3-3.4): one search, its GA at 30 x 25 over all 20 betas and the 4 angles, no
-#: refinement, Table 2's weights, the person -> model matching, the moments' alignment,
-#: its 512 px canvases, every measurement the fitted mesh's.
+#: The methods of ``fitter run --method``: bodyfit's default (the local solver from the
+#: mean body, chosen by measured error against time: docs/fitter.md "Choosing the
+#: defaults"); ``thorough``, the population search that was the default before it (two
+#: CMA-ES searches of 30 x 150 over 20 components, six refinements of 30 x 500 over 40,
+#: averaged: 99,000 candidates); and the paper's method exactly (Sections 3.3-3.4): one
+#: search, its GA at 30 x 25 over all 20 betas and the 4 angles, no refinement, Table 2's
+#: weights, the person -> model matching, the moments' alignment, its 512 px canvases,
+#: every measurement the fitted mesh's.
 METHODS = {
     "bodyfit": FitSettings(),
+    "thorough": FitSettings(search=SearchSettings(), solver=SolverSettings()),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False,
                                                searches=1, refine_components=0),
+                         solver=SolverSettings(),
                          canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
                          projection="orthographic",
                          render_cell_mm=0.0, placement_rounds=0, photo_extents=False),
@@ -333,6 +346,61 @@ def _refined(model, views, stature_m, first: SearchResult, settings, progress) -
                    else _mean_of(results, evaluator, conditioner))
 
 
+def _canvas_components(settings: FitSettings) -> int:
+    """The components whose extreme bodies the canvases cover: the search's, or the local
+    solver's when it solves for more."""
+    return max(settings.search.components if settings.search.searches else 1,
+               settings.solver.components if settings.solver.iterations else 1)
+
+
+def _solved(model, views, masks, intrinsics, stature_m, settings: FitSettings,
+            first: SearchResult | None) -> SearchResult:
+    """The local solver's answer (:mod:`bodyfit.fitter.fit.local_solver`), started from
+    ``first``'s (the searches' answer) or from the mean body (None), the pinhole cameras
+    placed anew from its body ``solver.placements`` times; joined to ``first`` by
+    :func:`~bodyfit.fitter.fit.search.refined`. Updates ``views`` to the cameras as
+    solved, and scores the answer with the search's cost there (its ``cost``, from which
+    the calibrated ± is read)."""
+    solver, s = settings.solver, settings.search
+    began = time.perf_counter()
+    at_k = dataclasses.replace(settings, search=dataclasses.replace(s, components=solver.components))
+    bodies = extreme_bodies(model, solver.components, s.pose_lower_deg, s.pose_upper_deg,
+                            settings.canvas.beta_limit)
+    evaluator, conditioner = _scoring(model, views, at_k, stature_m, bodies)
+    problem = LocalProblem(render_model(model, settings.render_cell_mm), views, settings.cost,
+                           conditioner, solver.components, s.pose_lower_deg, s.pose_upper_deg,
+                           s.beta_limit, solver)
+    start = np.zeros(problem.num_genes)
+    if first is not None:
+        betas = np.r_[first.betas, np.zeros(solver.components)][:solver.components]
+        start = np.r_[betas[1:], first.pose_deg]
+
+    def place(betas: np.ndarray, pose_deg: np.ndarray) -> None:
+        place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
+                      pose_deg)
+        for view in views.values():
+            problem.replace_view(view)
+
+    solved, trace = solve(problem, start, place if settings.projection == "pinhole" else None)
+    betas, pose = problem.body(solved)
+    for i, name in enumerate(problem.names):
+        views[name] = moved_view(views[name], solved[problem.num_genes + 3 * i:
+                                                     problem.num_genes + 3 * i + 3])
+        evaluator.replace_view(views[name])
+    scored = evaluator.evaluate(betas[None], pose[None])
+    genes = np.array(trace.genes) if trace.genes else start[None]
+    per_iteration = conditioner.complete(genes[:, :solver.components - 1],
+                                         genes[:, solver.components - 1:])
+    result = SearchResult(
+        betas=betas, pose_deg=pose, cost=float(scored.costs[0]),
+        part_costs=scored.part_costs[0], best_costs=np.array(trace.costs or [np.nan]),
+        mean_costs=np.array(trace.costs or [np.nan]), best_betas=per_iteration,
+        final_genes=np.r_[betas, pose][None], final_costs=scored.costs[:1].astype(np.float64),
+        evaluations=trace.evaluations, generations=len(trace.costs),
+        seconds=time.perf_counter() - began, stop_reasons={"solver": trace.stop_reason})
+    return result if first is None else refined(first, result)
+
+
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                   views: dict[str, kernels.ViewTarget], stature_m: float,
                   condition_stature: bool) -> tuple[np.ndarray, np.ndarray, dict]:
@@ -402,15 +470,19 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
         raise ValueError("the pinhole projection needs the photos' intrinsics")
     s = settings.search
     t0 = time.perf_counter()
-    bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
-                            settings.canvas.beta_limit)
+    bodies = extreme_bodies(model, _canvas_components(settings), s.pose_lower_deg,
+                            s.pose_upper_deg, settings.canvas.beta_limit)
     views = person_views(model, masks, stature_m, settings, intrinsics, bodies)
-    evaluator, conditioner = _scoring(model, views, settings, stature_m, bodies)
     t1 = time.perf_counter()
-    result = _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner,
-                       settings, progress)
-    if s.refine_components:
-        result = _refined(model, views, stature_m, result, settings, progress)
+    result = None
+    if s.searches:
+        evaluator, conditioner = _scoring(model, views, settings, stature_m, bodies)
+        result = _searched(model, views, masks, intrinsics, stature_m, evaluator, conditioner,
+                           settings, progress)
+        if s.refine_components:
+            result = _refined(model, views, stature_m, result, settings, progress)
+    if settings.solver.iterations:
+        result = _solved(model, views, masks, intrinsics, stature_m, settings, result)
     t2 = time.perf_counter()
     posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
                                              stature_m, s.condition_stature)
@@ -425,6 +497,18 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     t3 = time.perf_counter()
     return Fit(result, posed, rest, measurements, spreads, basis, views,
                {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies)
+
+
+def fit_work(settings: FitSettings, result: SearchResult) -> str:
+    """The work a fit did, in a few words (for the command line and the convergence plot)."""
+    s = settings.search
+    if not s.searches:
+        return (f"local solver, {result.generations} iterations "
+                f"({result.evaluations} bodies rendered)")
+    text = (f"{s.optimizer}: {result.evaluations} candidates"
+            + (f", {s.searches} searches' mean" if s.searches > 1 else "")
+            + (f", refined at K={s.refine_components}" if s.refine_components else ""))
+    return text + (", then the local solver" if settings.solver.iterations else "")
 
 
 def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = FitSettings(),

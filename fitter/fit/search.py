@@ -55,7 +55,8 @@ class SearchSettings:
             the person (:mod:`bodyfit.fitter.fit.stature`) instead of searching it (the paper
             searches it).
         searches: independent searches of each person (seeds ``seed``, ``seed + 1``, ...),
-            whose answers the fit averages (:func:`averaged`; the paper: 1). One search's
+            whose answers the fit averages (:func:`averaged`; the paper: 1); 0: no
+            population search (the fit's local solver starts from the mean body). One search's
             answer varies with its seed by about as much as its error (its cost's noise
             floor is flat across millimetres of shape), so the mean of two is nearer the
             truth (docs/history.md, [13]).
@@ -111,11 +112,14 @@ class SearchSettings:
                             f"the body model stores), got {self.refine_components}")
         for name, value, least in (("--population", self.population, 4),
                                    ("--generations", self.generations, 1),
-                                   ("--searches", self.searches, 1),
+                                   ("--searches", self.searches, 0),
                                    ("--refine-generations", self.refine_generations, 1),
                                    ("--refinements", self.refinements, 1)):
             if value is not None and value < least:
                 raise UserError(f"{name} must be at least {least}, got {value}")
+        if self.refine_components and not self.searches:
+            raise UserError("--refine-components refines the searches' answer: it needs "
+                            "--searches 1 or more")
         if not all(lo < hi for lo, hi in zip(self.pose_lower_deg, self.pose_upper_deg)):
             raise UserError("every pose lower bound must lie below its upper bound")
         if not 0 < self.sigma0 <= 1:

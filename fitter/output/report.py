@@ -79,8 +79,18 @@ def _measurement_table(values: dict[str, float], spreads: dict[str, float]) -> s
 
 def _settings_rows(record: dict) -> list[tuple[str, str]]:
     search, cost = record["settings"]["search"], record["settings"]["cost"]
+    solver = record["settings"]["solver"]
     result = record["result"]
     default = "the optimiser's default"
+    solver_row = ("local solver", f"{_e(solver['iterations'])} iterations at most, "
+                                  f"{_e(solver['components'])} components"
+                  if solver["iterations"] else "none")
+    if not search["searches"]:
+        return [("population search", "none"), solver_row,
+                ("ran", f"{result['generations']} iterations, {result['evaluations']} bodies "
+                        "rendered"),
+                ("matching", "model to person and person to model, sub-pixel"),
+                ("device", _e(record["settings"]["device"]))]
     return [
         ("optimizer", _e(search["optimizer"])),
         ("population", _e(search["population"] or default)),
@@ -92,6 +102,7 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
                        + (f", {_e(search['refinements'])} averaged"
                           if search["refinements"] > 1 else "")
          if search.get("refine_components") else "none"),
+        solver_row,
         ("matching", _e(cost["matching"])),
         ("seed", _e(search["seed"])),
         ("device", _e(record["settings"]["device"])),

@@ -20,6 +20,7 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import read_json_file
 from bodyfit.fitter.fit.canvas import CanvasSettings
+from bodyfit.fitter.fit.local_solver import SolverSettings
 from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import FitSettings
 from bodyfit.fitter.fit.search import SearchSettings
@@ -107,6 +108,15 @@ def _neck_as_head(settings):
     return {**settings, "cost": {**cost, "part_weights": neck_as_head}}
 
 
+def _without_solver(settings):
+    """run.json's ``settings`` object with the local solver off when it names none: a run
+    from before the solver (docs/history.md), whose settings are the population search's
+    alone. Anything else is returned as it is, for :func:`_build` to check."""
+    if isinstance(settings, dict) and "solver" not in settings:
+        return {**settings, "solver": {"iterations": 0}}
+    return settings
+
+
 def run_config(record: dict, where: str = "run.json") -> RunConfig:
     """The inputs, settings and output folder of a run.json payload.
 
@@ -119,9 +129,10 @@ def run_config(record: dict, where: str = "run.json") -> RunConfig:
         if key not in record:
             raise UserError(f"{where}: missing {key!r}; is it a fitter run's run.json?")
     inputs = _build(PersonInputs, record["inputs"], f"{where}: inputs")
-    settings = _build(FitSettings, _neck_as_head(record["settings"]), f"{where}: settings",
-                      {"search": SearchSettings, "canvas": CanvasSettings,
-                       "cost": kernels.CostSettings})
+    settings = _build(FitSettings, _without_solver(_neck_as_head(record["settings"])),
+                      f"{where}: settings",
+                      {"search": SearchSettings, "solver": SolverSettings,
+                       "canvas": CanvasSettings, "cost": kernels.CostSettings})
     base, output = record.get("working_dir"), record.get("output")
     for name, value in (("working_dir", base), ("output", output)):
         if value is not None and not isinstance(value, str):

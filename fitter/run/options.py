@@ -51,7 +51,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     ``refine_components``, that not given, turns the refinement off), the cost's
     (``matching``, ``vertical_anchor``, ``weights`` (a preset or a .toml file, replacing
     the weights) and ``weight`` (a list of ``NAME=VALUE`` overrides on top)), ``device``,
-    ``threads``, ``side_arms``, ``projection`` and ``placement_rounds``.
+    ``threads``, ``side_arms``, ``projection``, ``placement_rounds`` and the local solver's
+    ``iterations``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -72,7 +73,9 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     elif "weight" in given:  # on top of the method's or the recorded weights
         record = weights_record(cost) | dict(map(parse_override, given["weight"]))
         cost = settings_from_record(record, cost)
-    return dataclasses.replace(base, search=search, cost=cost,
+    solver = dataclasses.replace(base.solver, iterations=given.get("iterations",
+                                                                   base.solver.iterations))
+    return dataclasses.replace(base, search=search, solver=solver, cost=cost,
                                device=given.get("device", base.device),
                                threads=given.get("threads", base.threads),
                                side_arms=given.get("side_arms", base.side_arms),

@@ -28,7 +28,7 @@ from bodyfit import kernels
 from bodyfit.calib.images import write_image
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.person import PersonInputs
-from bodyfit.fitter.fit.person_fit import Fit, FitSettings, fit_inputs
+from bodyfit.fitter.fit.person_fit import Fit, FitSettings, fit_inputs, fit_work
 from bodyfit.fitter.fit.weights import weights_record
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel
 from bodyfit.fitter.output.mesh_io import write_mesh
@@ -109,16 +109,14 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
     check_output_dir(out_dir, overwrite)
     fit = fit_inputs(model, inputs, settings, progress)
     result = fit.search
-    s = settings.search
-    if s.refine_components:  # short enough to clear the axis label
-        title = (f"{s.optimizer}: {result.evaluations} candidates, "
-                 + (f"{s.searches} searches' mean, " if s.searches > 1 else "")
-                 + f"refined at K={s.refine_components}")
+    title = fit_work(settings, result)
+    if settings.search.searches:
+        chart = line_chart({"best so far": result.best_costs,
+                            "generation mean": result.mean_costs},
+                           title, "generation", "cost (weighted mm)", log_y=True)
     else:
-        title = (f"search: {s.optimizer}, {result.evaluations} candidates"
-                 + (f" in {s.searches} searches (their mean)" if s.searches > 1 else ""))
-    chart = line_chart({"best so far": result.best_costs, "generation mean": result.mean_costs},
-                       title, "generation", "cost (weighted mm)", log_y=True)
+        chart = line_chart({"cost": result.best_costs}, title, "iteration",
+                           "smooth cost (weighted mm^2)", log_y=True)
     with staged_directory(out_dir) as stage:
         for name, vertices in (("mesh.obj", fit.posed), ("mesh.ply", fit.posed),
                                ("mesh_rest.ply", fit.rest)):

@@ -1,8 +1,8 @@
 """The benchmarks' shared fixture: a small accuracy run made once for every command's test.
 
 4 in-space subjects (seed 2) photographed by ``make``, fitted by ``fit`` through the
-user's pipeline (calib capture, then fitter batch --camera) with a small budget (60
-generations, refinements of 20): about two minutes on two cores.
+user's pipeline (calib capture, then fitter batch --camera) with bodyfit's default method
+(the local solver): about a minute on two cores.
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ def small_run(tmp_path_factory) -> SmallRun:
     subject_set = folder / "set"
     main(["make", str(subject_set), "--kind", "in-space", "--count", "4", "--seed", "2",
           "--workers", "2"])
-    main(["fit", str(subject_set), "small", "--", "--generations", "60",
-          "--refine-generations", "20"])
+    main(["fit", str(subject_set), "small"])
     yield SmallRun(subject_set, "small")
     patch.undo()

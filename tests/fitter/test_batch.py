@@ -26,7 +26,7 @@ from bodyfit.fitter.run.results import RUN_FILES
 from bodyfit.kernels import cpu_threads
 
 #: A tiny budget: the tests check the batch, not the fit's accuracy.
-BUDGET = ["--projection", "orthographic", "--optimizer", "cmaes", "--population", "8",
+BUDGET = ["--method", "thorough", "--projection", "orthographic", "--optimizer", "cmaes", "--population", "8",
           "--generations", "2", "--seed", "3", "--refine-components", "0"]
 GOOD = ("s0", "s1", "s2", "s3")
 #: The six-row table: four good subjects, a blank front photo, a photo that does not exist.

@@ -36,7 +36,7 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     from bodyfit.fitter.run.results import RUN_FILES
 
     monkeypatch.chdir(tmp_path)
-    code, out, err = run(capsys, "-q", "demo", "-o", "demo", "--generations", "3")
+    code, out, err = run(capsys, "-q", "demo", "-o", "demo")
     assert code == 0, err
     out_dir = tmp_path / "demo"
     assert sorted(p.name for p in out_dir.iterdir()) == [
@@ -57,13 +57,13 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     truth = {row["letter"]: row["value_mm"] for row in truth_record["measurements"].values()}
     for key in MEASUREMENTS:
         assert truth[key] == pytest.approx(expected[key], abs=0.01)
-    # the fit went through `fitter run --camera` with its default settings (the refinement
-    # over 40 components among them), 3 generations each
+    # the fit went through `fitter run --camera` with its default settings: the local
+    # solver over 40 components, no population search
     record = json.loads((out_dir / "fit" / "run.json").read_text())
     assert record["settings"]["projection"] == "pinhole"
-    search = record["settings"]["search"]
-    assert (search["generations"], search["refine_generations"]) == (3, 3)
-    assert search["refine_components"] == 40 and len(record["result"]["betas"]) == 40
+    assert record["settings"]["search"]["searches"] == 0
+    assert record["settings"]["solver"]["iterations"] == 40
+    assert len(record["result"]["betas"]) == 40
     assert record["inputs"]["camera"] == "demo/camera.json"
     written = json.loads((out_dir / "fit" / "measurements.json").read_text())
     fitted = {row["letter"]: row["value_mm"] for row in written["measurements"].values()}
@@ -78,11 +78,11 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
         else:
             assert fitted[key] == pytest.approx(mesh[key], abs=0.01), key
     # the printed table: 16 rows of fitted, ±, true and error, then the important ones'
-    # mean; the ±'s kind named (3 generations are not the default method: the population's)
+    # mean; the ±'s kind named (the default method's: calibrated)
     rows = re.findall(r"^  ([A-P]) .+? +(-?\d+\.\d) +(\d+\.\d) +(-?\d+\.\d) +([+-]\d+\.\d)$",
                       out, re.MULTILINE)
     assert [key for key, *_ in rows] == list(MEASUREMENTS)
-    assert written["spread_basis"] == "population" and SPREAD_NOTES["population"] in out
+    assert written["spread_basis"] == "calibrated" and SPREAD_NOTES["calibrated"] in out
     for key, value, spread, true, error in rows:
         assert float(value) == pytest.approx(fitted[key], abs=0.06)
         assert float(spread) == pytest.approx(spreads[key], abs=0.06)
@@ -111,18 +111,19 @@ def test_version_and_usage_errors(capsys):
 
 @pytest.mark.parametrize("command", ["run", "batch"])
 def test_help_states_the_search_defaults(capsys, command):
-    """The help's "(default N)" of each search option is SearchSettings' own default."""
+    """The help's "(default N)" of each search option is the default method's own."""
     import re
 
-    from bodyfit.fitter.fit.search import SearchSettings
+    from bodyfit.fitter.fit.person_fit import FitSettings
 
     code, out, _ = run(capsys, command, "--help")
     assert code == 0
     text = " ".join(out.split())
-    defaults = SearchSettings()
+    defaults = FitSettings().search
     for option, value in (("--population", defaults.population),
                           ("--generations", defaults.generations),
                           ("--searches", defaults.searches),
+                          ("--iterations", FitSettings().solver.iterations),
                           ("--refine-generations", defaults.refine_generations),
                           ("--refinements", defaults.refinements)):
         stated = re.search(rf"{option} [A-Z_]+ (?:(?! --[a-z]).)*?\(default (\d+)", text)
@@ -187,7 +188,7 @@ def test_measure_other_topology_exit_2(body_model, tmp_path, capsys):
 @pytest.mark.parametrize("argv,message", [
     (["model", "build", "--samples", "7"], "--samples"),
     (["model", "build", "--components", "0"], "--components"),
-    (["demo", "--generations", "0"], "--generations"),
+    (["demo", "--method", "fast"], "--method"),
     (["demo", "-o", __file__], "is a file"),
     (["demo", "-o", f"{__file__}/inside"], "is a file"),  # a parent that is a file
     (["model", "build", "-o", "model.txt"], "-o takes a .npz"),

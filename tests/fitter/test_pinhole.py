@@ -181,7 +181,8 @@ def test_run_with_camera_writes_its_outputs(body_model, tmp_path, capsys):
     code = main(["-q", "run", "--front", str(tmp_path / "front.png"), "--side",
                  str(tmp_path / "side.png"), "--height-cm", f"{truth['O'] / 10:.2f}",
                  "--camera", str(tmp_path / "camera.json"), "-o", str(out),
-                 "--optimizer", "cmaes", "--population", "16", "--generations", "8",
+                 "--method", "thorough", "--optimizer", "cmaes", "--population", "16",
+                 "--generations", "8",
                  "--refine-components", "0"])
     assert code == 0, capsys.readouterr().err
     assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES)
@@ -203,8 +204,8 @@ def test_placement_rounds_never_end_the_search(body_model, tmp_path, capsys, gen
     out = tmp_path / "out"
     code = main(["-q", "run", "--front", str(tmp_path / "front.png"), "--side",
                  str(tmp_path / "side.png"), "--height-cm", f"{truth['O'] / 10:.2f}",
-                 "--camera", str(tmp_path / "camera.json"), "-o", str(out), "--population",
-                 "8", "--generations", str(generations), "--placement-rounds", str(rounds),
+                 "--camera", str(tmp_path / "camera.json"), "-o", str(out), "--method",
+                 "thorough", "--population", "8", "--generations", str(generations), "--placement-rounds", str(rounds),
                  "--refine-components", "0"])
     assert code == 0, capsys.readouterr().err
     record = json.loads((out / "run.json").read_text())

@@ -27,7 +27,7 @@ from bodyfit.kernels import CostSettings
 
 BETAS = np.r_[0.5, np.zeros(19)]
 POSE = np.array([5.0, 5.0, 3.0, 3.0])
-BUDGET = ["--optimizer", "ga", "--population", "10", "--generations", "2", "--seed", "5",
+BUDGET = ["--method", "thorough", "--optimizer", "ga", "--population", "10", "--generations", "2", "--seed", "5",
           "--weight", "waist=7", "--projection", "orthographic",  # orthographic studio photos
           "--refine-components", "0"]
 

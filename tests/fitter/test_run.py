@@ -13,7 +13,7 @@ from bodyfit.fitter.run.results import RUN_FILES
 
 TRUE_BETAS = np.array([0.8, -0.6, 0.5, 0.3, -0.4] + [0.0] * 15)
 TRUE_POSE = np.array([6.0, 6.0, 3.0, 3.0])
-BUDGET = ["--optimizer", "cmaes", "--population", "24", "--generations", "30", "--seed", "1",
+BUDGET = ["--method", "thorough", "--optimizer", "cmaes", "--population", "24", "--generations", "30", "--seed", "1",
           "--refine-components", "0"]
 
 
@@ -76,7 +76,7 @@ def test_default_fit_measures_the_subject(subject, tmp_path, capsys):
 
 def test_same_seed_same_result(subject, tmp_path, capsys):
     folder, truth = subject
-    budget = ["--optimizer", "ga", "--population", "12", "--generations", "3", "--seed", "4",
+    budget = ["--method", "thorough", "--optimizer", "ga", "--population", "12", "--generations", "3", "--seed", "4",
               "--refine-components", "0"]
     runs = []
     for name in ("a", "b"):
@@ -92,7 +92,8 @@ def test_two_searches_answer_with_the_mean_of_their_answers(subject, tmp_path, c
     betas 2..K of the single searches with seeds 4 and 5 (the first beta is solved anew
     from the stature), scored by the kernels at its own cost."""
     folder, truth = subject
-    budget = ["--population", "8", "--generations", "4", "--refine-components", "0"]
+    budget = ["--method", "thorough", "--population", "8", "--generations", "4",
+              "--refine-components", "0"]
     results = {}
     for name, options in (("4", ["--searches", "1", "--seed", "4"]),
                           ("5", ["--searches", "1", "--seed", "5"]),
@@ -121,7 +122,7 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
     with --refinements 1); the answer has 24 components, scored at its cost."""
     folder, truth = subject
     n = SearchSettings().refinements
-    budget = ["--population", "8", "--generations", "4", "--seed", "4"]
+    budget = ["--method", "thorough", "--population", "8", "--generations", "4", "--seed", "4"]
     refine = ["--refine-components", "24", "--refine-generations", "3"]
     results = {}
     for name, options in (("searches", ["--refine-components", "0"]), ("refined", refine),
@@ -159,8 +160,8 @@ def test_refinement_continues_from_the_searches_over_more_components(subject, tm
 
 def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     folder, truth = subject
-    budget = ["--optimizer", "ga", "--population", "8", "--generations", "1",
-              "--refine-components", "0"]
+    budget = ["--method", "thorough", "--optimizer", "ga", "--population", "8",
+              "--generations", "1", "--refine-components", "0"]
     costs = {}
     for name, extra in (("paper", []), ("waist", ["--weight", "waist=50"])):
         code, _, err = run(capsys, "run", *person_args(folder, truth), "-o",

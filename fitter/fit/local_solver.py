@@ -1,0 +1,357 @@
+"""The local solver: Levenberg-Marquardt on a smooth, sub-pixel silhouette cost.
+
+Where the population search (:mod:`bodyfit.fitter.fit.search`) scores whole candidates by
+their raster and needs tens of thousands of them, the local solver follows the cost's
+gradient from a start and needs tens of renders.
+
+The cost of a body (betas, the four angles, and a shift of each view's canvas, pixels):
+
+    cost = sum over views v, outline samples e:  W_e * rho(d_e)
+    d_e  = mm_per_px(v) * sd_v(x_e + shift_v)
+    W_e  = view weight(v) * part weight(e) * length_e / (sum of the view's lengths)
+
+with x_e the body's outline samples (:mod:`bodyfit.fitter.fit.outline`), sd_v the person's
+signed distance (pixels, negative inside the silhouette, zero half-way between an inside
+and an outside pixel centre) sampled bilinearly, the part and view weights of the fit's
+cost settings (Table 2's, as the search's), and rho Huber's loss (quadratic within
+``huber_mm``, linear beyond: a few stray pixels of a mask, a finger apart, do not pull the
+whole body). It is the search's model -> person matching, read off the mesh's outline
+instead of the raster's boundary pixels. A weak Gaussian prior on the betas
+(``prior`` mm^2 per sigma^2) keeps the directions the silhouettes cannot see at the mean.
+
+The stature is held as the search holds it: the first beta is solved from the others
+(:class:`~bodyfit.fitter.fit.stature.StatureConditioner`), and its derivative with respect
+to them enters the Jacobian. The pinhole cameras are placed anew from the body so far
+(``placements`` times, evenly through the iterations), as the search places them.
+
+The Jacobian is analytic (:meth:`~bodyfit.fitter.fit.outline.ViewOutline.jacobian`); the
+steps are Gauss-Newton's on the Huber-reweighted residuals, damped by Levenberg-Marquardt,
+each accepted only if it lowers the cost.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+import scipy.ndimage as ndi
+from scipy.spatial import cKDTree
+
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.fit.outline import ViewOutline, moved_camera
+from bodyfit.fitter.model.body_model import BodyModel, forward
+from bodyfit import kernels
+
+#: The blur (pixels) through which a silhouette's sub-pixel edge is read.
+_EDGE_SIGMA_PX = 1.0
+#: Pixels within this many of the boundary get their distance from the sub-pixel edge.
+_EDGE_BAND_PX = 4.0
+#: The Huber knee's fall per iteration (``SolverSettings.huber_start_mm``).
+_KNEE_FALL = 0.8
+#: How far (metres, each axis) the solver may move a view's camera from where it was placed.
+_CAMERA_REACH_M = 0.5
+
+__all__ = ["SolverSettings", "SolverTrace", "silhouette_edge", "signed_distance", "sample_bilinear",
+           "LocalProblem", "solve", "moved_view"]
+
+
+@dataclasses.dataclass(frozen=True)
+class SolverSettings:
+    """The local solver's settings.
+
+    Attributes:
+        iterations: Levenberg-Marquardt iterations at most (0: no local solver).
+        components: K, the shape components it solves for (up to those stored).
+        prior: mm^2 of cost per sigma^2 of every beta (a Gaussian prior at the mean).
+        huber_mm: the Huber loss's knee, millimetres at the person.
+        huber_start_mm: the knee of the first iteration; it falls geometrically by
+            ``_KNEE_FALL`` an iteration to ``huber_mm`` (far from the person, a body's
+            largest misfits, such as legs at another angle, carry the information; near
+            it, they are a mask's stray pixels).
+        placements: how often the pinhole cameras are placed anew from the body so far,
+            evenly through the iterations.
+        person_to_model: the share of the person -> model term in each view's cost (the
+            rest is the model -> person term's).
+        tolerance: stop when an accepted step lowers the cost by less than this share.
+    """
+
+    iterations: int = 0
+    components: int = 40
+    prior: float = 1e-3
+    huber_mm: float = 3.0
+    huber_start_mm: float = 30.0
+    placements: int = 3
+    person_to_model: float = 0.5
+    tolerance: float = 1e-5
+
+    def validate(self, stored_components: int) -> None:
+        if self.iterations < 0:
+            raise UserError(f"--iterations must be >= 0, got {self.iterations}")
+        if self.iterations and not 2 <= self.components <= stored_components:
+            raise UserError(f"--solver-components must be 2-{stored_components}, got "
+                            f"{self.components}")
+        if (self.prior < 0 or self.huber_mm <= 0 or self.placements < 0
+                or self.huber_start_mm < self.huber_mm):
+            raise UserError("the solver's prior and placements must be >= 0 and its "
+                            "Huber knees > 0, the first at least the last")
+        if not 0 <= self.person_to_model <= 1:
+            raise UserError(f"person_to_model must be in [0, 1], got {self.person_to_model}")
+
+
+def silhouette_edge(mask: np.ndarray) -> np.ndarray:
+    """(N, 2) float64 the edge of a (H, W) bool silhouette, sub-pixel, pixels (column, row):
+    where the mask, blurred by a Gaussian of ``_EDGE_SIGMA_PX``, crosses one half between
+    two neighbouring pixel centres of a row or a column (marching squares' edge points).
+    The blur reads an oblique edge's staircase as the line it samples: the binary mask's
+    own half-way points read it up to a tenth of a pixel outward, and a fit on them
+    answers with a body too large."""
+    level = cv2.GaussianBlur(np.asarray(mask, np.float64), (0, 0), _EDGE_SIGMA_PX,
+                             borderType=cv2.BORDER_REPLICATE) - 0.5
+    points = []
+    for axis in (1, 0):  # along rows (columns change), then along columns
+        a = level
+        b = np.roll(level, -1, axis=axis)
+        crossing = (a > 0) != (b > 0)
+        if axis == 1:
+            crossing[:, -1] = False
+        else:
+            crossing[-1, :] = False
+        rows, cols = np.nonzero(crossing)
+        t = a[rows, cols] / (a[rows, cols] - b[rows, cols])
+        points.append(np.stack([cols + t * (axis == 1), rows + t * (axis == 0)], axis=1))
+    return np.concatenate(points)
+
+
+def signed_distance(mask: np.ndarray, edge: np.ndarray) -> np.ndarray:
+    """(H, W) float64 signed distance from each pixel centre to a silhouette's edge, pixels,
+    negative inside: within ``_EDGE_BAND_PX`` of the (H, W) bool ``mask``'s boundary the
+    distance to the nearest of the sub-pixel ``edge`` points (:func:`silhouette_edge`),
+    farther out the exact distance to the nearest pixel centre across the boundary less
+    one half (the two differ by a fraction of a pixel, where no fit ends)."""
+    mask = np.asarray(mask, bool)
+    far = np.where(mask, 0.5 - ndi.distance_transform_edt(mask),
+                   ndi.distance_transform_edt(~mask) - 0.5)
+    rows, cols = np.nonzero(np.abs(far) < _EDGE_BAND_PX)
+    near, _ = cKDTree(edge).query(np.stack([cols, rows], axis=1).astype(np.float64))
+    far[rows, cols] = np.where(far[rows, cols] < 0, -near, near)
+    return far
+
+
+def sample_bilinear(field: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((N,) values, (N, 2) gradients d/d(column, row)) of a (H, W) field at (N, 2) pixel
+    points (column, row), bilinearly interpolated; points off the field read its edge."""
+    height, width = field.shape
+    u = np.clip(points[:, 0], 0.0, width - 1.000001)
+    v = np.clip(points[:, 1], 0.0, height - 1.000001)
+    c, r = np.floor(u).astype(int), np.floor(v).astype(int)
+    fu, fv = u - c, v - r
+    f00, f01 = field[r, c], field[r, c + 1]
+    f10, f11 = field[r + 1, c], field[r + 1, c + 1]
+    top = f00 + fu * (f01 - f00)
+    bottom = f10 + fu * (f11 - f10)
+    values = top + fv * (bottom - top)
+    du = (1 - fv) * (f01 - f00) + fv * (f11 - f10)
+    return values, np.stack([du, bottom - top], axis=1)
+
+
+@dataclasses.dataclass
+class SolverTrace:
+    """What the solver did, per iteration.
+
+    Attributes:
+        costs: the cost after each iteration (mm^2, the module docstring's).
+        genes: (iterations, K - 1 + 4) the solved genes after each.
+        evaluations: the bodies whose outlines were read (two renders each).
+        stop_reason: why it stopped.
+    """
+
+    costs: list[float] = dataclasses.field(default_factory=list)
+    genes: list[np.ndarray] = dataclasses.field(default_factory=list)
+    evaluations: int = 0
+    stop_reason: str = ""
+
+
+class LocalProblem:
+    """One person's smooth cost over the genes (betas 2..K, the four angles) and a
+    canvas shift per view.
+
+    Args:
+        model: the render model (:func:`~bodyfit.fitter.fit.render_mesh.render_model`).
+        views: view name -> the kernels' target (its canvas, camera, parts, fixed angles);
+            replace entries with :meth:`replace_view` when the cameras are placed anew.
+        cost: the fit's cost settings (part and view weights).
+        conditioner: the :class:`~bodyfit.fitter.fit.stature.StatureConditioner` over
+            ``components`` betas.
+        components: K.
+        pose_lower_deg, pose_upper_deg: (4,) the angles' bounds; beta_limit: the betas'.
+        settings: the solver's.
+    """
+
+    def __init__(self, model: BodyModel, views: dict[str, kernels.ViewTarget],
+                 cost: kernels.CostSettings, conditioner, components: int,
+                 pose_lower_deg, pose_upper_deg, beta_limit: float, settings: SolverSettings):
+        self.model, self.conditioner, self.settings = model, conditioner, settings
+        self.k = components
+        self.outlines = {name: ViewOutline(model, view) for name, view in views.items()}
+        self.person_edges = {name: silhouette_edge(view.silhouette)
+                             for name, view in views.items()}
+        self.distance = {name: signed_distance(view.silhouette, self.person_edges[name])
+                         for name, view in views.items()}
+        self.part_weights = np.asarray(cost.part_weights, np.float64)
+        self.view_weights = {"front": cost.front_weight, "side": cost.side_weight}
+        self.names = list(views)
+        genes = self.k - 1 + 4
+        self.lower = np.r_[np.full(self.k - 1, -beta_limit), pose_lower_deg,
+                           np.full(3 * len(views), -_CAMERA_REACH_M)]
+        self.upper = np.r_[np.full(self.k - 1, beta_limit), pose_upper_deg,
+                           np.full(3 * len(views), _CAMERA_REACH_M)]
+        self.num_genes = genes
+
+    def replace_view(self, view: kernels.ViewTarget) -> None:
+        """Score against ``view`` (the view of its name with its camera placed anew)."""
+        self.outlines[view.name].view = view
+
+    def body(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(betas (K,), pose (4,) degrees) of the parameters ``x``."""
+        genes = x[:self.num_genes]
+        betas = self.conditioner.complete(genes[None, :self.k - 1], genes[None, self.k - 1:])[0]
+        return betas, genes[self.k - 1:]
+
+    def _first_beta_slope(self, x: np.ndarray) -> np.ndarray:
+        """(K - 1,) d first beta / d betas 2..K (the stature held), by differences (the
+        solved beta is piecewise linear in the others)."""
+        genes = x[:self.num_genes]
+        others, pose = genes[:self.k - 1], genes[self.k - 1:]
+        step = 1e-3
+        rows = np.vstack([others[None], others[None] + step * np.eye(self.k - 1)])
+        first = self.conditioner.complete(rows, np.repeat(pose[None], len(rows), 0))[:, 0]
+        return (first[1:] - first[0]) / step
+
+    def residuals(self, x: np.ndarray, jacobian: bool = True):
+        """(weights W (S,), distances d (S,) mm, d d / d x (S, len(x)) or None) over every
+        view's outline samples."""
+        betas, pose = self.body(x)
+        weights, distances, rows = [], [], []
+        slope = self._first_beta_slope(x) if jacobian else None
+        for i, name in enumerate(self.names):
+            outline = self.outlines[name]
+            view = outline.view
+            posed = forward(self.model, betas[None], view.view_pose(pose[None]))[0]
+            first = self.num_genes + 3 * i
+            camera = moved_camera(view.camera, x[first:first + 3])
+            samples = outline.samples(posed.astype(np.float64), camera)
+            points = samples.points
+            mm = view.millimetres_per_pixel
+            view_weight = self.view_weights[name]
+            part_weights = self.part_weights[samples.parts]
+            share = 1.0 - self.settings.person_to_model
+            d_points = None
+            if jacobian:
+                d_pixels = outline.jacobian(samples, betas, pose, camera)  # (S, 2, K + 7)
+                d_points = np.zeros((len(points), 2, len(x)))
+                d_points[:, :, :self.num_genes] = np.concatenate(
+                    [d_pixels[:, :, 1:self.k] + d_pixels[:, :, :1] * slope[None, None],
+                     d_pixels[:, :, self.k:self.k + 4]], axis=2)
+                d_points[:, :, first:first + 3] = d_pixels[:, :, self.k + 4:]
+            if share > 0:  # model -> person: the person's signed distance at each sample
+                sd, grad = sample_bilinear(self.distance[name], points)
+                lengths = samples.lengths / max(samples.lengths.sum(), 1e-9)
+                weights.append(share * view_weight * part_weights * lengths)
+                distances.append(mm * sd)
+                if jacobian:
+                    rows.append(mm * np.einsum("si,sik->sk", grad, d_points))
+            if share < 1:  # person -> model: each outline point to the nearest sample's edge
+                person = self.person_edges[name]
+                _, nearest = cKDTree(points).query(person)
+                normals = samples.normals[nearest]
+                gap = np.einsum("si,si->s", person - points[nearest], normals)
+                weights.append((1.0 - share) * view_weight * part_weights[nearest]
+                               / len(person))
+                distances.append(mm * gap)
+                if jacobian:
+                    rows.append(-mm * np.einsum("si,sik->sk", normals, d_points[nearest]))
+        return (np.concatenate(weights), np.concatenate(distances),
+                np.concatenate(rows) if jacobian else None)
+
+    def cost(self, weights: np.ndarray, distances: np.ndarray, x: np.ndarray,
+             knee: float) -> float:
+        """The cost of the residuals (Huber's loss with its ``knee``, mm) plus the prior,
+        mm^2."""
+        a = np.abs(distances)
+        rho = np.where(a <= knee, a * a, 2 * knee * a - knee * knee)
+        betas = x[:self.k - 1]
+        return float(weights @ rho + self.settings.prior * betas @ betas)
+
+
+def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndarray, SolverTrace]:
+    """Levenberg-Marquardt from ``start`` (genes (K - 1 + 4,); the shifts start at 0).
+
+    Args:
+        problem: the person's cost.
+        start: the genes to start from.
+        place: None, or called with (betas (K,), pose (4,)) to place the cameras anew
+            (it calls ``problem.replace_view``), ``settings.placements`` times.
+
+    Returns:
+        (the solved parameters: genes then shifts, the trace).
+    """
+    s = problem.settings
+    x = np.clip(np.r_[start, np.zeros(3 * len(problem.names))], problem.lower, problem.upper)
+    trace = SolverTrace()
+    at = {round(s.iterations * (i + 1) / (s.placements + 1)) for i in range(s.placements)}
+    damping = 1e-3
+    prior = np.zeros(len(x))
+    prior[:problem.k - 1] = s.prior
+    weights, distances, jac = problem.residuals(x)
+    trace.evaluations += 1
+    for iteration in range(s.iterations):
+        if place is not None and iteration in at:
+            place(*problem.body(x))
+            x[problem.num_genes:] = 0.0  # the cameras stand where the placement put them
+            weights, distances, jac = problem.residuals(x)
+            trace.evaluations += 1
+        knee = max(s.huber_mm, s.huber_start_mm * _KNEE_FALL ** iteration)
+        cost = problem.cost(weights, distances, x, knee)
+        a = np.abs(distances)
+        reweight = weights * np.where(a <= knee, 1.0, knee / np.maximum(a, 1e-12))
+        normal = (jac * reweight[:, None]).T @ jac + np.diag(prior)
+        gradient = jac.T @ (reweight * distances) + prior * x
+        improved = False
+        for _ in range(8):
+            step = np.linalg.solve(normal + damping * np.diag(np.diag(normal) + 1e-9),
+                                   -gradient)
+            trial = np.clip(x + step, problem.lower, problem.upper)
+            t_weights, t_distances, _ = problem.residuals(trial, jacobian=False)
+            trace.evaluations += 1
+            t_cost = problem.cost(t_weights, t_distances, trial, knee)
+            if t_cost < cost:
+                improved = True
+                damping = max(damping / 3, 1e-7)
+                break
+            damping *= 4
+        if not improved:
+            trace.stop_reason = "no step lowers the cost"
+            break
+        x = trial
+        weights, distances, jac = problem.residuals(x)
+        trace.evaluations += 1
+        trace.costs.append(problem.cost(weights, distances, x, s.huber_mm))
+        trace.genes.append(x[:problem.num_genes].copy())
+        if ((cost - t_cost) < s.tolerance * cost and knee == s.huber_mm
+                and iteration + 1 not in at):
+            trace.stop_reason = "the cost stopped falling"
+            break
+    else:
+        trace.stop_reason = "iterations"
+    return x, trace
+
+
+def moved_view(view: kernels.ViewTarget, translation_m: np.ndarray) -> kernels.ViewTarget:
+    """``view`` with its camera moved as the solver moved it (``translation_m`` (3,)
+    metres added to the camera's translation, :func:`~bodyfit.fitter.fit.outline.
+    moved_camera`), its millimetres per pixel scaled with the model origin's depth."""
+    depth = float(np.array(view.camera.translation)[2])
+    return dataclasses.replace(
+        view, camera=moved_camera(view.camera, translation_m),
+        millimetres_per_pixel=view.millimetres_per_pixel * (depth + translation_m[2]) / depth)

@@ -1,0 +1,135 @@
+"""The local solver (fitter/fit/local_solver.py) and the outline it reads (fitter/fit/outline.py):
+the signed distance and its sampling, the mesh's edges, the analytic Jacobian against finite
+differences, and a known body recovered from its own photos."""
+
+import cv2
+import numpy as np
+import pytest
+
+from bodyfit.fitter.demo.studio_photos import BACKDROP_BGR, write_pinhole_subject
+from bodyfit.fitter.fit.canvas import extreme_bodies
+from bodyfit.fitter.fit.local_solver import (LocalProblem, SolverSettings, sample_bilinear,
+                                             signed_distance, silhouette_edge, solve)
+from bodyfit.fitter.fit.outline import MeshEdges, ViewOutline, moved_camera, project_with_jacobian
+from bodyfit.fitter.fit.pinhole_canvas import pinhole_view
+from bodyfit.fitter.fit.render_mesh import render_model
+from bodyfit.fitter.fit.side_arms import side_view_options
+from bodyfit.fitter.fit.stature import StatureConditioner
+from bodyfit.fitter.fit.weights import cost_settings
+from bodyfit.fitter.model.body_model import forward, rest_shape
+from bodyfit.kernels import prepare_view_target, rasterize
+from bodyfit.kernels.target import visible_faces
+
+SIZE_PX = (750, 1000)
+K_TRUE = np.array([[820.0, 0.0, 381.0], [0.0, 812.0, 488.0], [0.0, 0.0, 1.0]])
+BETAS = np.array([1.2, 0.7, -0.8, 0.4, 0.5, -0.6, 0.3] + [0.0] * 13)
+POSE = np.array([5.0, 7.0, 3.0, 4.0])
+
+
+def person_mask(path):
+    return np.any(cv2.imread(str(path)) != np.array(BACKDROP_BGR, np.uint8), axis=2)
+
+
+@pytest.fixture(scope="module")
+def subject(body_model, tmp_path_factory):
+    """A body of the model's space photographed through a known pinhole camera: (folder,
+    true measurements)."""
+    folder = tmp_path_factory.mktemp("subject")
+    truth = write_pinhole_subject(folder, body_model, BETAS, POSE, K_TRUE, SIZE_PX, 2.9, 1.2)
+    return folder, truth
+
+
+def test_signed_distance_of_a_half_plane_is_linear():
+    mask = np.zeros((8, 20), bool)
+    mask[:, :10] = True  # the edge half-way between the centres of columns 9 and 10
+    edge = silhouette_edge(mask)
+    np.testing.assert_allclose(edge[:, 0], 9.5)
+    distance = signed_distance(mask, edge)
+    np.testing.assert_allclose(distance[3], np.arange(20) - 9.5)
+    values, gradients = sample_bilinear(distance, np.array([[12.3, 4.6], [9.5, 2.0], [3.25, 7.0]]))
+    np.testing.assert_allclose(values, [2.8, 0.0, -6.25])
+    np.testing.assert_allclose(gradients, [[1.0, 0.0]] * 3)
+
+
+def test_mesh_edges_of_a_tetrahedron_and_of_a_lone_triangle():
+    tetrahedron = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]])
+    edges = MeshEdges.of(tetrahedron)
+    assert len(edges.vertices) == 6 and (edges.faces >= 0).all()
+    for (a, b), (f, g) in zip(edges.vertices, edges.faces):
+        assert f != g and {a, b} <= set(tetrahedron[f]) and {a, b} <= set(tetrahedron[g])
+    lone = MeshEdges.of(np.array([[0, 1, 2]]))
+    assert sorted(map(tuple, lone.vertices)) == [(0, 1), (0, 2), (1, 2)]
+    assert (lone.faces[:, 1] == -1).all()
+
+
+@pytest.mark.parametrize("name", ["front", "side"])
+def test_outline_jacobian_matches_finite_differences(body_model, subject, name):
+    folder, truth = subject
+    model = render_model(body_model, 8.0)
+    options = {} if name == "front" else side_view_options(body_model, "down")
+    mean = forward(model, np.zeros((1, 20)), np.zeros((1, 4)))[0]
+    extent = extreme_bodies(model, 20, [-10.0] * 4, [30.0] * 4).reshape(-1, 3)
+    view = pinhole_view(name, person_mask(folder / f"{name}.png"), K_TRUE, truth["O"] / 1000,
+                        extent, mean, model.vertex_parts, **options)
+    outline = ViewOutline(model, view)
+    rng = np.random.default_rng(1)
+    betas, pose = rng.normal(0.0, 0.7, 20), np.array([6.0, 9.0, -2.0, 4.0])
+    camera = moved_camera(view.camera, np.array([0.01, -0.02, 0.05]))
+    posed = forward(model, betas[None], view.view_pose(pose[None]))[0].astype(np.float64)
+    samples = outline.samples(posed, camera)
+    assert len(samples.points) > 400
+    jacobian = outline.jacobian(samples, betas, pose, camera)
+
+    def points(b, p, t):
+        body = forward(model, b[None], view.view_pose(p[None]))[0].astype(np.float64)
+        ends, _ = project_with_jacobian(moved_camera(view.camera, t),
+                                        body[samples.edges.ravel()])
+        return ends.reshape(-1, 2, 2).mean(axis=1)
+
+    base = points(betas, pose, np.array([0.01, -0.02, 0.05]))
+    step = np.r_[np.full(20, 0.02), np.full(4, 0.02), np.full(3, 1e-4)]
+    for column in [0, 1, 5, 13, 19, 20, 21, 22, 23, 24, 25, 26]:
+        x = np.r_[betas, pose, 0.01, -0.02, 0.05]
+        x[column] += step[column]
+        numeric = (points(x[:20], x[20:24], x[24:]) - base) / step[column]
+        scale = max(np.abs(jacobian[:, :, column]).max(), 1e-3)
+        assert np.abs(numeric - jacobian[:, :, column]).max() < 0.01 * scale + 2e-3, column
+    if name == "side":  # the side view's shoulders are fixed: the arms do not move
+        assert not jacobian[:, :, 20:22].any()
+
+
+def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, subject):
+    """The analytic case: the silhouettes are a body's own renders through the views'
+    cameras, the body one of the solver's candidates (10 components); from the mean body,
+    the solver finds its shape and pose again."""
+    folder, truth = subject
+    model = render_model(body_model, 8.0)
+    k = 10
+    betas = np.r_[BETAS[:k]]
+    stature = float(np.ptp(rest_shape(body_model, betas[None])[0][0][:, 2]))
+    extent = extreme_bodies(body_model, k, [-10.0] * 4, [30.0] * 4)
+    views = {}
+    for name in ("front", "side"):
+        options = {} if name == "front" else side_view_options(body_model, "down")
+        mean = forward(model, np.zeros((1, k)), np.zeros((1, 4)))[0]
+        placed = pinhole_view(name, person_mask(folder / f"{name}.png"), K_TRUE, stature,
+                              extent.reshape(-1, 3), mean, model.vertex_parts, **options)
+        body = forward(model, betas[None], placed.view_pose(POSE[None]))[0]
+        faces, parts = visible_faces(model.faces, model.face_parts, placed.visible_parts)
+        own = rasterize(body[None], faces, parts, placed.camera, placed.height,
+                        placed.width).numpy()[0] >= 0
+        views[name] = prepare_view_target(name, own, placed.camera,
+                                          placed.millimetres_per_pixel, **options)
+    conditioner = StatureConditioner(body_model, k, stature, 3.0, extent)
+    settings = SolverSettings(iterations=40, components=k, placements=0)
+    problem = LocalProblem(model, views, cost_settings("bodyfit"), conditioner, k,
+                           (-10.0,) * 4, (30.0,) * 4, 3.0, settings)
+    solved, trace = solve(problem, np.zeros(problem.num_genes))
+    found_betas, found_pose = problem.body(solved)
+    np.testing.assert_allclose(found_pose, POSE, atol=0.3)
+    np.testing.assert_allclose(found_betas, betas, atol=0.15)
+    found, true = (measurer.measure(rest_shape(body_model, b[None])[0][0])
+                   for b in (found_betas, betas))
+    errors = {key: found[key] - true[key] for key in "BCDEFLP"}
+    assert max(map(abs, errors.values())) < 1.0, errors
+    assert np.abs(solved[problem.num_genes:]).max() < 0.01  # the cameras stay, metres
