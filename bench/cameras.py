@@ -1,9 +1,9 @@
 """Benchmark of `fitter run`'s cameras: what the projection costs on pinhole photos.
 
-    python -m bench.cameras                    # 4 subjects, CMA-ES 30 x 100
+    python -m bench.cameras                    # 4 subjects, bodyfit's default method
     python -m bench.cameras --subjects 3 --seed 5
 
-In-space subjects as bench/fitter_speed.py (bodies of the model's 20-component space,
+In-space subjects as bench/subjects.py draws them (bodies of the model's 20-component space,
 betas normal clipped at +-2 sigma, limbs 2-8 degrees out), photographed front and side by
 :func:`bodyfit.fitter.demo.studio_photos.write_pinhole_subject` (a painter's renderer, not the
 kernels) through a pinhole camera unlike the no-camera assumption (:data:`TRUE_HFOV_DEG`
@@ -25,9 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.subjects import ERROR_HEADER, draw_subject, error_cells, fit_each_setting
+from bench.subjects import draw_subject, fit_each_setting, settings_table
 from bodyfit.fitter.demo.studio_photos import write_pinhole_subject
-from bodyfit.fitter.measure.measurements import IMPORTANT
 from bodyfit.fitter.model.cache import load_model
 
 SIZE_PX = (1500, 2000)
@@ -35,7 +34,8 @@ SIZE_PX = (1500, 2000)
 #: principal point 12 px right of and 18 px above the centre.
 TRUE_HFOV_DEG = 66.0
 TRUE_CENTRE_OFFSET_PX = (12.0, -18.0)
-BUDGET = ["--optimizer", "cmaes", "--population", "30", "--generations", "150"]
+#: The method: bodyfit's default (before the local solver, CMA-ES 30 x 150: history.md).
+BUDGET: list[str] = []
 #: name -> `fitter run` options (``{camera}``: the subject's camera.json).
 SETTINGS = {
     "(a) orthographic, no camera (the paper's)": ["--projection", "orthographic"],
@@ -76,10 +76,7 @@ def main() -> None:
           f"{time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
           f"`fitter run {' '.join(BUDGET)}` on the CPU, start-up included; camera distance / "
           f"height per subject: {', '.join(scenes)}.\n")
-    print(f"| camera handling | wall s (mean) | {ERROR_HEADER} |")
-    print("|---|---|---|" + "---|" * (len(IMPORTANT) + 1))
-    for name in SETTINGS:
-        print(f"| {name} | {np.mean(seconds[name]):.1f} | {error_cells(errors[name])} |")
+    print("\n".join(settings_table("camera handling", seconds, errors)))
     sys.stdout.flush()
 
 

@@ -1,9 +1,10 @@
-"""Ablations of `fitter run`'s defaults: each row changes one choice, same subjects, seeds.
+"""Ablations of the population search's choices (`--method thorough`, the default before
+the local solver): each row changes one choice, same subjects, seeds.
 
     python -m bench.choices                       # 4 subjects, CMA-ES 30 x 150
     python -m bench.choices --subjects 6 --generations 200
 
-In-space subjects as bench/fitter_speed.py draws them (studio photos, the side with the
+In-space subjects as bench/subjects.py draws them (studio photos, the side with the
 arms down), fitted through `fitter run`'s own path (calib's silhouettes, then
 ``fit_person``). Besides the measurement errors it reports the cost of the found body and
 of the true one (its betas and front pose; with the stature conditioned, the true body as
@@ -29,7 +30,7 @@ from bodyfit import kernels
 from bodyfit.fitter.demo.studio_photos import write_subject
 from bodyfit.fitter.fit.canvas import extreme_bodies
 from bodyfit.fitter.fit.person import PersonInputs, person_masks
-from bodyfit.fitter.fit.person_fit import FitSettings, fit_person, stature_conditioner
+from bodyfit.fitter.fit.person_fit import METHODS, FitSettings, fit_person, stature_conditioner
 from bodyfit.fitter.fit.weights import cost_settings
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.model.cache import load_model
@@ -76,7 +77,7 @@ def main() -> None:
     parser.add_argument("--generations", type=int, default=150)
     args = parser.parse_args()
     model = load_model()
-    base = FitSettings()
+    base = METHODS["thorough"]
     base = dataclasses.replace(base, projection="orthographic", search=dataclasses.replace(
         base.search, generations=args.generations))  # the studio photos are orthographic
     variants = _variants(base)

@@ -1,100 +1,94 @@
-"""Benchmark of `fitter run`: measurement error against time, per search setting.
+"""Benchmark of `fitter run`: measurement error against wall time, per method and budget.
 
-    python -m bench.fitter_speed                    # 4 subjects, the settings below
-    python -m bench.fitter_speed --subjects 8 --seed 3 --plot docs/fitter_error_vs_time.png
-    python -m bench.fitter_speed --device cuda:0    # the kernels on a GPU
+    python -m bench.fitter_speed SETS/in SETS/out --first 2
+    python -m bench.fitter_speed SETS/in SETS/out --first 2 --device cuda:0
 
-In-space subjects: bodies drawn from the model's own 20-component space (betas normal,
-clipped at +-2 sigma; limbs 2-8 degrees out), photographed front and side (the side
-with the arms hanging down) by :mod:`bodyfit.fitter.demo.studio_photos` (a painter's renderer,
-not the kernels; orthographic, 700 px tall), then fitted by the `fitter run` command
-itself, start-up included, once per setting. Error: |fitted - true| of the 16
-measurements, mm. Prints Markdown (docs/fitter.md holds the output) and writes the
+Subjects: the first N rows of accuracy benchmark sets (``python -m bench.accuracy make``;
+in-space and out-of-space bodies photographed through a phone camera, calibrated into
+SET/camera.json by ``python -m bench.accuracy fit`` or ``calib capture``). Each is
+fitted by the `fitter run` command itself with ``--camera``, start-up included, once per
+setting, one after another on this machine. Error: the 7 important measurements' mean
+|fitted - true|, mm. Prints Markdown (docs/fitter.md holds the output) and writes the
 error-against-time plot.
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
+import json
 import os
 import platform
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-from bench.subjects import ERROR_HEADER, draw_subject, error_cells, fit_each_setting
+from bench.subjects import fit_each_setting, settings_table
 from bodyfit.calib.images import write_image
-from bodyfit.fitter.demo.studio_photos import write_subject
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
-from bodyfit.fitter.model.cache import load_model
 from bodyfit.fitter.output.plots import line_chart
 
-#: name -> `fitter run` options: the paper's method and bodyfit's defaults at several
-#: budgets (candidates = population x generations), for error against time.
+#: name -> `fitter run` options: bodyfit's default (the local solver) at several
+#: iteration budgets, the population search that was the default before (``thorough``)
+#: at its full budget and at one search alone, and the paper's method at two budgets.
 SETTINGS = {
+    "bodyfit: 5 iterations": ["--iterations", "5"],
+    "bodyfit: 10 iterations": ["--iterations", "10"],
+    "bodyfit (default): 40 iterations": [],
+    "thorough: one search 30 x 150": ["--method", "thorough", "--searches", "1",
+                                      "--refine-components", "0"],
+    "thorough (the default before)": ["--method", "thorough"],
     "paper: GA 30 x 25": ["--method", "paper"],
     "paper: GA 30 x 200": ["--method", "paper", "--generations", "200"],
-    "bodyfit: CMA-ES 30 x 50": ["--generations", "50"],
-    "bodyfit: CMA-ES 30 x 100": ["--generations", "100"],
-    "bodyfit (default): CMA-ES 30 x 150": [],
-    "bodyfit: CMA-ES 30 x 200": ["--generations", "200"],
-    "bodyfit: CMA-ES 30 x 400": ["--generations", "400"],
 }
-#: The studio photos are orthographic: every setting fits them so (the paper's method
-#: does by default; bodyfit's default is a pinhole camera, for real photos).
-PHOTO_OPTIONS = ["--projection", "orthographic"]
 #: The curves of the error-against-time plot: name -> the settings on it.
-CURVES = {"paper's method (GA)": [name for name in SETTINGS if name.startswith("paper")],
-          "bodyfit (CMA-ES)": [name for name in SETTINGS if name.startswith("bodyfit")]}
+CURVES = {family: [name for name in SETTINGS if name.startswith(prefix)]
+          for family, prefix in (("bodyfit (local solver)", "bodyfit"),
+                                 ("thorough (CMA-ES)", "thorough"),
+                                 ("paper (GA)", "paper"))}
 
 
-def _candidates(options: list[str]) -> int:
-    paper = "paper" in options
-    generations = int(options[options.index("--generations") + 1]) \
-        if "--generations" in options else (25 if paper else 150)
-    return 30 * generations
+def _subjects(set_folder: Path, first: int) -> list[tuple[Path, dict[str, float]]]:
+    """(subject folder, true measurements key -> mm) of the set's first ``first`` rows."""
+    with open(set_folder / "subjects.csv", newline="") as table:
+        rows = list(csv.DictReader(table))[:first]
+    return [(set_folder / row["id"],
+             json.loads((set_folder / row["id"] / "truth.json").read_text())["measurements"])
+            for row in rows]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(prog="python -m bench.fitter_speed",
                                      description=__doc__.splitlines()[0])
-    parser.add_argument("--subjects", type=int, default=4)
-    parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("sets", nargs="+", type=Path, help="subject set folders")
+    parser.add_argument("--first", type=int, default=2, help="subjects of each set")
     parser.add_argument("--plot", type=Path, default=Path("docs/fitter_error_vs_time.png"),
                         help="error-against-time plot to write")
     parser.add_argument("--device", default="cpu", help="`fitter run --device` (cpu, cuda:0)")
     args = parser.parse_args()
-    model = load_model()
-    rng = np.random.default_rng(args.seed)
     errors = {name: [] for name in SETTINGS}
     seconds = {name: [] for name in SETTINGS}
-    with tempfile.TemporaryDirectory() as scratch:
-        for i in range(args.subjects):
-            folder = Path(scratch) / f"s{i}"
-            folder.mkdir()
-            truth = write_subject(folder, model, *draw_subject(rng))
-            fit_each_setting(folder, truth, SETTINGS, [*PHOTO_OPTIONS, "--device", args.device],
-                             errors, seconds)
+    for set_folder in args.sets:
+        for folder, truth in _subjects(set_folder, args.first):
+            fit_each_setting(folder, truth, SETTINGS,
+                             ["--camera", str(set_folder / "camera.json"), "--device",
+                              args.device], errors, seconds, photo_suffix=".jpg")
     keys = list(MEASUREMENTS)
     important = [keys.index(k) for k in IMPORTANT]
-    device = "" if args.device == "cpu" else f" --device {args.device}"
-    print(f"`python -m bench.fitter_speed --subjects {args.subjects} --seed {args.seed}{device}` "
-          f"on {time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
-          f"`fitter run` on {args.device}, start-up included.\n")
-    print(f"| setting | candidates | wall s (mean) | {ERROR_HEADER} |")
-    print("|---|---|---|---|" + "---|" * (len(IMPORTANT) + 1))
-    for name, options in SETTINGS.items():
-        print(f"| {name} | {_candidates(options)} | {np.mean(seconds[name]):.1f} | "
-              f"{error_cells(errors[name])} |")
+    count = len(next(iter(errors.values())))
+    print(f"`python -m bench.fitter_speed {' '.join(map(str, args.sets))} --first {args.first}"
+          f"{'' if args.device == 'cpu' else ' --device ' + args.device}` on "
+          f"{time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
+          f"`fitter run --camera` on {args.device}, start-up included, {count} subjects.\n")
+    print("\n".join(settings_table("setting", seconds, errors, np.median)))
     mean7 = {name: np.abs(np.array(errors[name]))[:, important].mean() for name in SETTINGS}
     chart = line_chart({curve: [mean7[n] for n in names] for curve, names in CURVES.items()},
-                       f"fitter run, {args.subjects} in-space subjects", "wall seconds per subject",
-                       "7 important measurements, mean abs. error (mm)", log_y=True,
-                       x_values={curve: [np.mean(seconds[n]) for n in names]
-                                 for curve, names in CURVES.items()})
+                       f"fitter run --camera, {count} subjects", "wall seconds per subject "
+                       "(median)", "7 important measurements, mean abs. error (mm)",
+                       log_y=True, x_values={curve: [np.median(seconds[n]) for n in names]
+                                             for curve, names in CURVES.items()})
     write_image(args.plot, chart)
     print(f"\nPlot: `{args.plot}`.")
     sys.stdout.flush()

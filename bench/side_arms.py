@@ -3,7 +3,7 @@
     python -m bench.side_arms                    # 4 subjects, CMA-ES 30 x 100
     python -m bench.side_arms --subjects 3 --population 24 --generations 60
 
-In-space subjects as in bench/fitter_speed.py (betas normal clipped at +-2 sigma, limbs
+In-space subjects as bench/subjects.py draws them (betas normal clipped at +-2 sigma, limbs
 2-8 degrees out, the same draws for the same --seed), photographed by
 :mod:`bodyfit.fitter.demo.studio_photos` twice: the side photo with the arms hidden and with
 the arms hanging down (the front photo is the same A-pose). Each photo pair is fitted by
@@ -34,6 +34,7 @@ import warp
 
 from bench.subjects import draw_subject
 from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.fit.local_solver import SolverSettings
 from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
 from bodyfit.fitter.fit.search import SearchSettings
@@ -75,9 +76,9 @@ def main() -> None:
                 inputs = PersonInputs(str(folder / "front.png"), str(folder / "side.png"),
                                       truth["O"] / 10)
                 start = time.perf_counter()
-                fit = fit_inputs(model, inputs, FitSettings(search=search, side_arms=fit_arms,
-                                                            projection="orthographic"),
-                                 progress=False)
+                settings = FitSettings(search=search, solver=SolverSettings(),  # the search
+                                       side_arms=fit_arms, projection="orthographic")
+                fit = fit_inputs(model, inputs, settings, progress=False)
                 seconds[name].append(time.perf_counter() - start)
                 errors[name].append({k: fit.measurements[k] - truth[k] for k in truth})
     print(f"`python -m bench.side_arms --subjects {args.subjects} --seed {args.seed} "

@@ -16,7 +16,8 @@ import numpy as np
 
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
 
-__all__ = ["ERROR_HEADER", "draw_subject", "fit_by_command", "fit_each_setting", "error_cells"]
+__all__ = ["ERROR_HEADER", "draw_subject", "fit_by_command", "fit_each_setting", "error_cells",
+           "settings_table"]
 
 #: The Markdown header cells of :func:`error_cells`.
 ERROR_HEADER = "7 important, mean abs. error (mm) | " + " | ".join(IMPORTANT) + " | O"
@@ -29,13 +30,14 @@ def draw_subject(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
 
 
 def fit_by_command(folder: Path, truth: dict[str, float], out: Path,
-                   options: list[str]) -> tuple[float, list[float]]:
-    """Fit the subject photographed in ``folder`` (front.png, side.png) with the `fitter run`
-    command itself, start-up included; return (wall seconds, the 16 errors fitted - true
-    in ``MEASUREMENTS`` order, mm)."""
+                   options: list[str], photo_suffix: str = ".png") -> tuple[float, list[float]]:
+    """Fit the subject photographed in ``folder`` (front and side, ``photo_suffix``) with the
+    `fitter run` command itself, start-up included; return (wall seconds, the 16 errors
+    fitted - true in ``MEASUREMENTS`` order, mm)."""
     start = time.perf_counter()
-    subprocess.run(["fitter", "-q", "run", "--front", str(folder / "front.png"), "--side",
-                    str(folder / "side.png"), "--height-cm", f"{truth['O'] / 10:.2f}",
+    subprocess.run(["fitter", "-q", "run", "--front", str(folder / f"front{photo_suffix}"),
+                    "--side", str(folder / f"side{photo_suffix}"),
+                    "--height-cm", f"{truth['O'] / 10:.2f}",
                     "-o", str(out), *options], check=True, stdout=subprocess.DEVNULL)
     seconds = time.perf_counter() - start
     table = json.loads((out / "measurements.json").read_text())["measurements"]
@@ -44,15 +46,16 @@ def fit_by_command(folder: Path, truth: dict[str, float], out: Path,
 
 
 def fit_each_setting(folder: Path, truth: dict[str, float], settings: dict[str, list[str]],
-                     common: list[str], errors: dict[str, list], seconds: dict[str, list]
-                     ) -> None:
+                     common: list[str], errors: dict[str, list], seconds: dict[str, list],
+                     photo_suffix: str = ".png") -> None:
     """Fit the subject in ``folder`` once per setting (its options after ``common``;
     ``{camera}`` in an option stands for ``folder/camera.json``) by :func:`fit_by_command`
-    into ``folder/out<i>``, appending the wall seconds and the 16 errors to
+    into ``folder/out<i>`` (replaced), appending the wall seconds and the 16 errors to
     ``seconds[name]`` and ``errors[name]``."""
     for index, (name, options) in enumerate(settings.items()):
         options = [option.format(camera=folder / "camera.json") for option in options]
-        wall, error = fit_by_command(folder, truth, folder / f"out{index}", [*common, *options])
+        wall, error = fit_by_command(folder, truth, folder / f"out{index}",
+                                     [*common, *options, "--overwrite"], photo_suffix)
         seconds[name].append(wall)
         errors[name].append(error)
 
@@ -66,3 +69,14 @@ def error_cells(errors: list[list[float]]) -> str:
     return " | ".join(f"{value:.1f}" for value in
                       [err[:, important].mean(), *err[:, important].mean(axis=0),
                        err[:, keys.index("O")].mean()])
+
+
+def settings_table(label: str, seconds: dict[str, list[float]], errors: dict[str, list],
+                   average=np.mean) -> list[str]:
+    """Markdown lines: one row per setting (``label`` heads the first column) of its wall
+    seconds per subject (``average`` of them, named in the header) and its
+    :func:`error_cells`."""
+    lines = [f"| {label} | wall s ({average.__name__}) | {ERROR_HEADER} |",
+             "|---|---|---|" + "---|" * (len(IMPORTANT) + 1)]
+    return lines + [f"| {name} | {average(seconds[name]):.1f} | {error_cells(errors[name])} |"
+                    for name in seconds]

@@ -7,24 +7,25 @@ Run from the repository root (docs/accuracy.md holds what they measured)::
     python -m bench.accuracy make SETS/out --kind out-of-space --count 200 --seed 0
     # fit it as a user would: calib capture on the board photos, then fitter batch with
     # the calibrated camera (fitter batch options after --; resumable: rerun to continue)
-    python -m bench.accuracy fit SETS/in default
+    python -m bench.accuracy fit SETS/in bodyfit
+    python -m bench.accuracy fit SETS/in thorough --first 54 -- --method thorough
     python -m bench.accuracy fit SETS/in uniform-weights --first 100 -- --weights uniform
     python -m bench.accuracy fit SETS/in no-camera --first 100 --camera none
     # a run's results merged into the setting kept in git (docs/accuracy-runs/in-space/
-    # default.csv and the set's truths.csv), e.g. rows 100-199 fitted in a later session
-    python -m bench.accuracy keep SETS/in default
-    python -m bench.accuracy fit SETS/in default-b --first 200 --skip 100
-    python -m bench.accuracy keep SETS/in default-b --setting default
+    # bodyfit.csv and the set's truths.csv), e.g. rows 100-199 fitted in a later session
+    python -m bench.accuracy keep SETS/in bodyfit
+    python -m bench.accuracy fit SETS/in bodyfit-b --first 200 --skip 100
+    python -m bench.accuracy keep SETS/in bodyfit-b --setting bodyfit
     # Markdown tables of kept settings or runs (SOURCE+SOURCE: joined, each subject from
     # the first that holds it); --first/--skip: the set's rows skip to first - 1 only
     python -m bench.accuracy report --first 200 \
-        --main "in-space=docs/accuracy-runs/in-space/default.csv" \
+        --main "in-space=docs/accuracy-runs/in-space/bodyfit.csv" \
         --ablation "uniform weights=SETS/in/runs/uniform-weights"
     # the calibrated ± (fitter/fit/spreads.py) on a setting's fits; --write makes a
     # calibration of them (bodyfit's: fitter/data/spread_calibration.json)
-    python -m bench.accuracy spread docs/accuracy-runs/out-of-space/default.csv --first 72
+    python -m bench.accuracy spread docs/accuracy-runs/out-of-space/bodyfit.csv --first 72
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
-    python -m bench.accuracy figures SETS/in --curve "bodyfit=default" \
+    python -m bench.accuracy figures SETS/in --curve "bodyfit=bodyfit" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
 
 ``make --bodies-only`` stops after drawing the bodies (bodies.npz, set.json: the

@@ -4,25 +4,36 @@ Where the population search (:mod:`bodyfit.fitter.fit.search`) scores whole cand
 their raster and needs tens of thousands of them, the local solver follows the cost's
 gradient from a start and needs tens of renders.
 
-The cost of a body (betas, the four angles, and a shift of each view's canvas, pixels):
+The parameters ``x``: the genes (betas 2..K, standard deviations; the four abduction
+angles, degrees) and, per view, a move of the camera (3 metres, camera frame, within
+``_CAMERA_REACH_M`` of where the placement put it). The cost of a body:
 
-    cost = sum over views v, outline samples e:  W_e * rho(d_e)
-    d_e  = mm_per_px(v) * sd_v(x_e + shift_v)
-    W_e  = view weight(v) * part weight(e) * length_e / (sum of the view's lengths)
+    cost = sum over views v:  (1 - p) * sum_e W_e rho(mm_v * sd_v(x_e))
+                            +      p  * sum_z W_z rho(mm_v * n_e(z) . (z - x_e(z)))
+                            + prior * |betas 2..K|^2
+    W_e  = view weight(v) * part weight(e) * length_e / (the view's outline length)
+    W_z  = view weight(v) * part weight(e(z)) / (the person's edge points in v)
 
-with x_e the body's outline samples (:mod:`bodyfit.fitter.fit.outline`), sd_v the person's
-signed distance (pixels, negative inside the silhouette, zero half-way between an inside
-and an outside pixel centre) sampled bilinearly, the part and view weights of the fit's
-cost settings (Table 2's, as the search's), and rho Huber's loss (quadratic within
-``huber_mm``, linear beyond: a few stray pixels of a mask, a finger apart, do not pull the
-whole body). It is the search's model -> person matching, read off the mesh's outline
-instead of the raster's boundary pixels. A weak Gaussian prior on the betas
-(``prior`` mm^2 per sigma^2) keeps the directions the silhouettes cannot see at the mean.
+- model -> person: each outline sample x_e of the body
+  (:mod:`bodyfit.fitter.fit.outline`) at the person's signed distance sd_v (pixels,
+  negative inside, :func:`signed_distance`), sampled bilinearly;
+- person -> model: each point z of the person's sub-pixel edge (:func:`silhouette_edge`)
+  to the line of its nearest sample e(z) (normal n_e), which sees what the first cannot:
+  a gap between the legs the body fills, a hand it does not reach;
+- ``p`` is ``person_to_model``, mm_v the view's millimetres per pixel, the part and view
+  weights the fit's cost settings' (Table 2's, as the search's), rho Huber's loss
+  (quadratic within the knee, linear beyond), the prior a weak Gaussian one that keeps
+  the directions the silhouettes cannot see at the mean.
+
+The knee falls from ``huber_start_mm`` to ``huber_mm`` over the first iterations: far from
+the person the body's largest misfits (legs at another angle) carry the information; near
+it they are a mask's stray pixels, which must not pull the whole body.
 
 The stature is held as the search holds it: the first beta is solved from the others
-(:class:`~bodyfit.fitter.fit.stature.StatureConditioner`), and its derivative with respect
-to them enters the Jacobian. The pinhole cameras are placed anew from the body so far
-(``placements`` times, evenly through the iterations), as the search places them.
+(:class:`~bodyfit.fitter.fit.stature.StatureConditioner`), its slope with respect to them
+entering the Jacobian. The pinhole cameras are solved with the body, and may be placed
+anew from the body so far (``placements`` times, evenly through the iterations) as the
+search places them.
 
 The Jacobian is analytic (:meth:`~bodyfit.fitter.fit.outline.ViewOutline.jacobian`); the
 steps are Gauss-Newton's on the Huber-reweighted residuals, damped by Levenberg-Marquardt,
@@ -162,7 +173,7 @@ class SolverTrace:
     Attributes:
         costs: the cost after each iteration (mm^2, the module docstring's).
         genes: (iterations, K - 1 + 4) the solved genes after each.
-        evaluations: the bodies whose outlines were read (two renders each).
+        evaluations: the bodies whose outlines were read (one render a view each).
         stop_reason: why it stopped.
     """
 
@@ -173,8 +184,8 @@ class SolverTrace:
 
 
 class LocalProblem:
-    """One person's smooth cost over the genes (betas 2..K, the four angles) and a
-    canvas shift per view.
+    """One person's smooth cost (the module docstring) over the genes (betas 2..K, the
+    four angles) and a camera move per view.
 
     Args:
         model: the render model (:func:`~bodyfit.fitter.fit.render_mesh.render_model`).
@@ -201,12 +212,11 @@ class LocalProblem:
         self.part_weights = np.asarray(cost.part_weights, np.float64)
         self.view_weights = {"front": cost.front_weight, "side": cost.side_weight}
         self.names = list(views)
-        genes = self.k - 1 + 4
+        self.num_genes = self.k - 1 + 4
         self.lower = np.r_[np.full(self.k - 1, -beta_limit), pose_lower_deg,
                            np.full(3 * len(views), -_CAMERA_REACH_M)]
         self.upper = np.r_[np.full(self.k - 1, beta_limit), pose_upper_deg,
                            np.full(3 * len(views), _CAMERA_REACH_M)]
-        self.num_genes = genes
 
     def replace_view(self, view: kernels.ViewTarget) -> None:
         """Score against ``view`` (the view of its name with its camera placed anew)."""
@@ -285,7 +295,7 @@ class LocalProblem:
 
 
 def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndarray, SolverTrace]:
-    """Levenberg-Marquardt from ``start`` (genes (K - 1 + 4,); the shifts start at 0).
+    """Levenberg-Marquardt from ``start`` (genes (K - 1 + 4,); the cameras where they stand).
 
     Args:
         problem: the person's cost.
@@ -294,7 +304,7 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
             (it calls ``problem.replace_view``), ``settings.placements`` times.
 
     Returns:
-        (the solved parameters: genes then shifts, the trace).
+        (the solved parameters: genes, then each view's camera move, the trace).
     """
     s = problem.settings
     x = np.clip(np.r_[start, np.zeros(3 * len(problem.names))], problem.lower, problem.upper)

@@ -26,14 +26,25 @@ from __future__ import annotations
 
 import abc
 import dataclasses
+import functools
 import logging
+import typing
 import warnings
 
 import numpy as np
 
-with warnings.catch_warnings():  # cma warns on import when matplotlib is missing
-    warnings.filterwarnings("ignore", message="Could not import matplotlib")
+if typing.TYPE_CHECKING:
     import cma
+
+@functools.cache
+def _cma():
+    """The ``cma`` package, imported on first use: with scipy.stats it takes 0.3-0.7 s to
+    import, which a fit without a population search (bodyfit's default) never needs."""
+    with warnings.catch_warnings():  # cma warns on import when matplotlib is missing
+        warnings.filterwarnings("ignore", message="Could not import matplotlib")
+        import cma
+    return cma
+
 
 __all__ = [
     "OPTIMIZER_NAMES",
@@ -527,13 +538,13 @@ class CmaEvolutionStrategy(Optimizer):
         self._asked_normalised: list[np.ndarray] = []
         self._es = self._start(self._normalise(x0), settings.population)
 
-    def _start(self, mean: np.ndarray, population: int | None) -> cma.CMAEvolutionStrategy:
+    def _start(self, mean: np.ndarray, population: int | None) -> "cma.CMAEvolutionStrategy":
         options = {"bounds": [0.0, 1.0], "seed": np.nan,  # nan: cma leaves np.random alone
                    "randn": lambda *shape: self._rng.standard_normal(shape),
                    "verbose": -9, "verb_log": 0, "verb_disp": 0}
         if population is not None:
             options["popsize"] = population
-        return cma.CMAEvolutionStrategy(mean, self.settings.sigma0, options)
+        return _cma().CMAEvolutionStrategy(mean, self.settings.sigma0, options)
 
     def _normalise(self, x: np.ndarray) -> np.ndarray:
         return (x - self.lower) / (self.upper - self.lower)

@@ -93,6 +93,9 @@ class FitSettings:
         self.solver.validate(stored_components)
         if not (self.search.searches or self.solver.iterations):
             raise UserError("--searches 0 needs the local solver (--iterations 1 or more)")
+        if self.solver.iterations and not self.search.condition_stature:
+            raise UserError("the local solver holds the stature: --free-stature needs "
+                            "--iterations 0 (a population search alone)")
         self.canvas.validate()
         if self.threads is not None and self.threads < 1:
             raise UserError(f"--threads must be at least 1, got {self.threads}")
@@ -491,6 +494,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                                        masks, intrinsics)
     if calibration_applies(settings, METHODS["bodyfit"]):
         spreads, basis = bodyfit_calibration().spreads(answer_cost(result)), "calibrated"
+    elif not s.searches:  # the solver alone: no population to measure
+        spreads, basis = bodyfit_calibration().spreads(answer_cost(result)), "solver"
     else:
         spreads, basis = population_spreads(model, measurer, result, stature_m
                                             if s.condition_stature else None), "population"

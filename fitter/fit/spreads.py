@@ -1,28 +1,30 @@
 """The ± a fit reports with each measurement, millimetres.
 
-Two kinds (``SPREAD_BASES``):
+Three kinds (``SPREAD_BASES``):
 
 - ``"calibrated"``, for fits with bodyfit's default method (:func:`calibration_applies`):
   the measurement's factor from ``data/spread_calibration.json`` times the fit's
-  *answer cost*, the mean cost (weighted mm, Eq. 17) of the answers the fit averaged
-  (its six refinements; one answer's cost when it averaged none). The factors are such
-  that on the accuracy benchmark's out-of-space subjects (full Anny bodies photographed
-  through a phone camera: the benchmark's stand-in for real people) the truth lay within
-  the ± for 68.3 % of the subjects, each measurement (one standard deviation's share of
-  a normal error); they come from ``python -m bench.accuracy spread`` on the default's
-  88 held-out out-of-space fits (docs/accuracy.md, "The protocol": made from half of
-  them, the ± held the truth for 67.7 % of the other half's measurements, each half in
-  turn). The
-  cost scales the ± because a body the model's space cannot reproduce leaves its
-  silhouettes matched worse: the in-space subjects' answer costs are about three fifths of
-  the out-of-space ones', their errors smaller still. Real photos (clothes, hair, a
-  segmentation less clean than the benchmark's) may err more than this ± says.
-- ``"population"``, for any other settings: the best quarter of the searches' final
-  populations, pooled (at least three with a finite cost), are measured like the fitted
-  body, and each measurement's spread is their standard deviation. It says how well the
-  photos pinned a measurement down under that search, not how near the truth is (on the
-  benchmark it held the truth for 15-64 % of the subjects per measurement, and did not
-  rank the subjects by their errors).
+  *answer cost*, the cost (weighted mm, Eq. 17: the search's pixel cost) of its answer
+  (the mean of the answers a fit averaged, for the population searches). The factors are
+  such that on the accuracy benchmark's out-of-space subjects (full Anny bodies
+  photographed through a phone camera: the benchmark's stand-in for real people) the
+  truth lay within the ± for 68.3 % of the subjects, each measurement (one standard
+  deviation's share of a normal error); they come from ``python -m bench.accuracy
+  spread`` on the default's held-out out-of-space fits (docs/accuracy.md, "The
+  protocol"; the calibration file names its command). The cost scales the ± because a
+  body the model's space cannot reproduce leaves its silhouettes matched worse: the
+  in-space subjects' answer costs are smaller than the out-of-space ones', their errors
+  smaller still. Real photos (clothes, hair, a segmentation less clean than the
+  benchmark's) may err more than this ± says.
+- ``"solver"``, for fits that end with the local solver alone under other settings (no
+  population to measure): the default method's factors times the fit's answer cost, as
+  above, but not checked against the truth for these settings.
+- ``"population"``, for the population searches' other settings: the best quarter of the
+  searches' final populations, pooled (at least three with a finite cost), are measured
+  like the fitted body, and each measurement's spread is their standard deviation. It
+  says how well the photos pinned a measurement down under that search, not how near the
+  truth is (on the benchmark it held the truth for 15-64 % of the subjects per
+  measurement, and did not rank the subjects by their errors).
 
 The stature (O) is the person's own, given: its calibrated ± is a few hundredths of a mm.
 """
@@ -46,12 +48,14 @@ __all__ = ["SPREAD_BASES", "SPREAD_NOTES", "CALIBRATION_FILE", "CALIBRATION_FORM
            "population_spreads", "read_calibration", "recorded_answer_cost"]
 
 #: The kinds of ± (module docstring); a fit's ``spread_basis`` is one of them.
-SPREAD_BASES = ("calibrated", "population")
+SPREAD_BASES = ("calibrated", "solver", "population")
 #: What each kind of ± means, in a sentence for the report and the command line.
 SPREAD_NOTES = {
     "calibrated": "the ± held the truth for 68 % of the accuracy benchmark's out-of-space "
                   "subjects (synthetic photos), scaled by how well this fit matched the "
                   "silhouettes; real photos may err more",
+    "solver": "the ± is the default method's calibration applied to this fit's cost; "
+              "for these settings it is not checked against the truth",
     "population": "the ± is the measurement's standard deviation over the best quarter of "
                   "the searches' final populations (settings other than the default "
                   "method's), not a confidence interval",

@@ -21,7 +21,7 @@ from bodyfit.fitter.fit.spreads import read_calibration
 ROOT = Path(__file__).resolve().parents[2]
 #: The small run's 7 important measurements' mean error with bodyfit's default, mm (the
 #: report's figure, to its 0.01 mm).
-PINNED_MEAN_OF_7 = 0.0
+PINNED_MEAN_OF_7 = 1.34
 
 
 def mean_of_7(report: str, label: str) -> float:
@@ -147,7 +147,7 @@ def test_spread_writes_the_calibration_it_prints(small_run, capsys, tmp_path):
     factors = dict(re.findall(r"^\| ([A-P]) [^|]+\| ([.\d]+) \|", printed, re.M))
     assert factors.keys() == calibration.per_cost.keys()
     for key, factor in factors.items():
-        assert float(factor) == pytest.approx(calibration.per_cost[key], abs=5e-4)
+        assert float(factor) == pytest.approx(calibration.per_cost[key], abs=5.01e-4)
     printed = bench(capsys, "spread", str(small_run.run), "--calibration", str(written))
     assert f"{written}'s calibration (4 subjects)" in printed
     rows = re.findall(r"^\| ([A-P]) [^|]+\| ([.\d]+) \| ([.\d]+) \| (\d+)% \|", printed, re.M)

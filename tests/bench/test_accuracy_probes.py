@@ -18,9 +18,10 @@ from bodyfit.fitter.measure.measurements import MEASUREMENTS
 
 
 @pytest.fixture(scope="module")
-def mean7(small_run) -> float:
-    """The small run's 7 important measurements' mean |error|, as its report prints it."""
-    return round(mean_of_important(read_source(small_run.run).errors)[0], 2)
+def mean7(small_thorough_run) -> float:
+    """The small thorough run's 7 important measurements' mean |error|, as its report
+    prints it."""
+    return round(mean_of_important(read_source(small_thorough_run.run).errors)[0], 2)
 
 
 def test_remeasure_gives_a_fit_its_own_measurements_back(small_run, capsys):
@@ -50,15 +51,15 @@ def test_remeasure_gives_a_fit_its_own_measurements_back(small_run, capsys):
                                atol=0.05)
 
 
-def test_budgets_own_budget_is_the_runs_own_error(small_run, capsys, mean7):
+def test_budgets_own_budget_is_the_runs_own_error(small_thorough_run, capsys, mean7):
     """Shorter refinements read from the same run: its own budget gives its own error (a
     round trip); a budget longer than the run's is refused."""
-    printed = probe(capsys, "budgets", str(small_run.set_folder), small_run.name,
+    printed = probe(capsys, "budgets", str(small_thorough_run.set_folder), small_thorough_run.name,
                     "--generations", "0", "10", "20")
     longest = re.search(r"\| 20 \|(?: [.\d]+ \|){7} ([.\d]+) \(", printed)
     assert float(longest[1]) == pytest.approx(mean7, abs=0.06)
     with pytest.raises(SystemExit, match="fewer than 30"):
-        probe(capsys, "budgets", str(small_run.set_folder), small_run.name, "--generations", "30")
+        probe(capsys, "budgets", str(small_thorough_run.set_folder), small_thorough_run.name, "--generations", "30")
 
 
 def test_outlines_default_passes_sit_on_the_exact_edge(small_run, capsys):
@@ -79,27 +80,27 @@ def test_floor_of_in_space_bodies_is_zero_at_their_own_components(small_run, cap
     assert floor[20] < 0.05 and floor[5] > 1.0
 
 
-def test_combine_rebuilds_each_fits_own_measurements(small_run, capsys, mean7):
+def test_combine_rebuilds_each_fits_own_measurements(small_thorough_run, capsys, mean7):
     """The first rule, the answers' mean, rebuilds each fit's own measurements from run.json
     (a few hundredths of a millimetre apart); its neck section's circumference is the
     report's neck error; the first three answers only are the mean of the first three."""
-    printed = probe(capsys, "combine", str(small_run.set_folder), small_run.name)
+    printed = probe(capsys, "combine", str(small_thorough_run.set_folder), small_thorough_run.name)
     assert float(re.search(r"rebuilt to within ([.\d]+) mm", printed)[1]) < 0.05
     assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) .* \| \+0\.00 ± 0\.00 \|",
                      printed)[1] == f"{mean7:.2f}"
     neck = re.search(r"mean \|error\|: circumference ([.\d]+) mm; width ([.\d]+) mm", printed)
     assert float(neck[2]) > 0
     first3 = re.search(r"\| the mean of the first 3 \| ([.\d]+) ", printed)[1]
-    printed = probe(capsys, "combine", str(small_run.set_folder), small_run.name,
+    printed = probe(capsys, "combine", str(small_thorough_run.set_folder), small_thorough_run.name,
                     "--answers", "3")
     assert "averaged 3 answers" in printed and "rebuilt" not in printed
     assert re.search(r"\| the mean of all \(the fit's\) \| ([.\d]+) ", printed)[1] == first3
 
 
-def test_costs_the_truth_is_cheaper_than_a_short_search(small_run, capsys):
+def test_costs_the_truth_is_cheaper_than_a_short_search(small_thorough_run, capsys):
     """Drawn from the space the fit searches, the truth's closest body scores cheaper on the
     fit's views than a 60-generation search's answer."""
-    printed = probe(capsys, "costs", str(small_run.set_folder), small_run.name, "--first", "2")
+    printed = probe(capsys, "costs", str(small_thorough_run.set_folder), small_thorough_run.name, "--first", "2")
     row = re.search(r"\| the fit's answer \| 2 \| ([.\d]+) \| ([.\d]+) \| \S+ ± [.\d]+ \| (\d) \|",
                     printed)
     assert float(row[2]) < float(row[1]) and row[3] == "2"

@@ -1,16 +1,20 @@
 """The local solver (fitter/fit/local_solver.py) and the outline it reads (fitter/fit/outline.py):
 the signed distance and its sampling, the mesh's edges, the analytic Jacobian against finite
-differences, and a known body recovered from its own photos."""
+differences, a known body recovered from its own renders, and the settings it refuses."""
+
+import dataclasses
 
 import cv2
 import numpy as np
 import pytest
 
+from bodyfit.common.errors import UserError
 from bodyfit.fitter.demo.studio_photos import BACKDROP_BGR, write_pinhole_subject
 from bodyfit.fitter.fit.canvas import extreme_bodies
 from bodyfit.fitter.fit.local_solver import (LocalProblem, SolverSettings, sample_bilinear,
                                              signed_distance, silhouette_edge, solve)
 from bodyfit.fitter.fit.outline import MeshEdges, ViewOutline, moved_camera, project_with_jacobian
+from bodyfit.fitter.fit.person_fit import METHODS, FitSettings
 from bodyfit.fitter.fit.pinhole_canvas import pinhole_view
 from bodyfit.fitter.fit.render_mesh import render_model
 from bodyfit.fitter.fit.side_arms import side_view_options
@@ -133,3 +137,18 @@ def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, s
     errors = {key: found[key] - true[key] for key in "BCDEFLP"}
     assert max(map(abs, errors.values())) < 1.0, errors
     assert np.abs(solved[problem.num_genes:]).max() < 0.01  # the cameras stay, metres
+
+
+def test_settings_the_solver_cannot_fit_with_are_one_line_errors():
+    default = FitSettings()
+    free = dataclasses.replace(default, search=dataclasses.replace(default.search,
+                                                                     condition_stature=False))
+    with pytest.raises(UserError, match="--free-stature needs --iterations 0"):
+        free.validate(60)
+    nothing = dataclasses.replace(default, solver=SolverSettings(iterations=0))
+    with pytest.raises(UserError, match="--searches 0 needs the local solver"):
+        nothing.validate(60)
+    with pytest.raises(UserError, match="--refine-components refines the searches"):
+        dataclasses.replace(default, search=dataclasses.replace(
+            default.search, refine_components=50)).validate(60)
+    METHODS["thorough"].validate(60)  # the population search alone

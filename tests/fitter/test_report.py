@@ -15,6 +15,7 @@ from bodyfit.common.errors import UserError
 from bodyfit.fitter.cli.main import main
 from bodyfit.fitter.demo.studio_photos import write_subject
 from bodyfit.fitter.fit import person_fit as fit_module
+from bodyfit.fitter.fit.local_solver import SolverSettings
 from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import FitSettings
 from bodyfit.fitter.fit.search import SearchSettings
@@ -105,6 +106,7 @@ def test_run_json_round_trips_into_the_same_settings(first_run):
     assert config.settings == FitSettings(
         search=SearchSettings(optimizer="ga", population=10, generations=2, seed=5,
                               refine_components=0),
+        solver=SolverSettings(),  # the run's --method thorough: no local solver
         projection="orthographic",
         cost=dataclasses.replace(FitSettings().cost, part_weights=tuple(weights)))
     assert config.inputs.front.endswith("front.png") and config.output == first_run
@@ -116,6 +118,16 @@ def test_run_json_round_trips_into_the_same_settings(first_run):
                                     "settings": dataclasses.asdict(custom)}))
     again = run_config(record)
     assert again.settings == custom and again.inputs == inputs and again.output is None
+
+
+def test_run_json_from_before_the_solver_runs_without_it(first_run):
+    """A run.json without ``settings.solver`` (written before the local solver) repeats
+    its population search alone, not the search and then today's solver."""
+    record = json.loads((first_run / "run.json").read_text())
+    del record["settings"]["solver"]
+    assert run_config(record).settings.solver.iterations == 0
+    record["settings"]["solver"] = {"iterations": 12}
+    assert run_config(record).settings.solver == SolverSettings(iterations=12)
 
 
 def test_run_json_of_nine_parts_weighs_the_neck_as_its_head(first_run):
@@ -191,12 +203,12 @@ def test_without_config_the_person_is_required(capsys):
     ({}, 40), ({"components": 30}, 40), ({"components": 40}, 0), ({"components": 50}, 0),
     ({"components": 40, "refine_components": 50}, 50), ({"refine_components": 0}, 0)])
 def test_components_at_or_past_the_refinement_turn_it_off(options, refine):
-    """bodyfit's refinement over 40 components adds none to a search of 40 or more: it is
+    """thorough's refinement over 40 components adds none to a search of 40 or more: it is
     off unless --refine-components is given too (and then validated as given)."""
     from bodyfit.fitter.fit.person_fit import METHODS
     from bodyfit.fitter.run.options import fit_settings
 
-    settings = fit_settings(METHODS["bodyfit"], {"components": None, **options})
+    settings = fit_settings(METHODS["thorough"], {"components": None, **options})
     assert settings.search.refine_components == refine
     assert fit_settings(METHODS["paper"], options).search.refine_components == options.get(
         "refine_components", 0)

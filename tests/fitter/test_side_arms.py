@@ -8,6 +8,7 @@ import pytest
 from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.fit.local_solver import SolverSettings
 from bodyfit.fitter.fit.person import PersonInputs, person_masks
 from bodyfit.fitter.fit.person_fit import FitSettings, fit_person
 from bodyfit.fitter.fit.search import SearchSettings
@@ -83,8 +84,8 @@ def test_a_side_photo_with_the_arms_down_costs_the_true_body_little_only_with_ar
     side_cost = {}
     for arms in ("down", "hidden"):
         fit = fit_person(body_model, masks, truth["O"] / 1000,
-                         FitSettings(search=search, side_arms=arms,
-                                             projection="orthographic"), progress=False)
+                         FitSettings(search=search, solver=SolverSettings(), side_arms=arms,
+                                     projection="orthographic"), progress=False)
         arrays = kernels.ModelArrays.from_body_model(body_model, 20)
         evaluator = kernels.PopulationEvaluator(arrays, [fit.views["side"]])
         part_costs = evaluator.evaluate(BETAS[None], POSE[None]).part_costs[0]

@@ -54,7 +54,7 @@ def test_calibration_file_round_trips_and_bad_files_are_refused():
 def test_bodyfits_calibration_covers_every_measurement():
     own = bodyfit_calibration()
     assert list(own.per_cost) == list(MEASUREMENTS) and own.coverage == COVERAGE
-    assert own.subjects >= 20 and "bench_accuracy.py spread" in own.source
+    assert own.subjects >= 20 and "bench.accuracy spread" in own.source
     assert all(factor > 0 for factor in own.per_cost.values())
     assert own.per_cost["O"] < 0.01  # the stature is given
 
@@ -66,6 +66,9 @@ def test_calibration_applies_to_the_default_method_alone():
         default, device="cuda:0", threads=3,
         search=dataclasses.replace(default.search, seed=7)), default)
     assert not calibration_applies(METHODS["paper"], default)
+    assert not calibration_applies(METHODS["thorough"], default)
+    assert not calibration_applies(dataclasses.replace(
+        default, solver=dataclasses.replace(default.solver, iterations=10)), default)
     assert not calibration_applies(dataclasses.replace(
         default, search=SearchSettings(refinements=4)), default)
     assert not calibration_applies(dataclasses.replace(default, projection="orthographic"),
