@@ -95,7 +95,8 @@ class OutlineSamples:
         lengths: (S,) float64, the edge's projected length, pixels (the sample's share of
             the outline).
         parts: (S,) int, the part (index into ``PART_NAMES``) of the edge's first vertex.
-        normals: (S, 2) float64, unit normals of the projected edges (either sense).
+        normals: (S, 2) float64, unit normals of the projected edges, pointing out of the
+            body.
     """
 
     edges: np.ndarray
@@ -221,18 +222,7 @@ class ViewOutline:
     def samples(self, posed: np.ndarray, camera: kernels.ViewCamera) -> OutlineSamples:
         """The outline of a body posed as this view renders it, (V, 3) metres, seen by
         ``camera`` (the view's, or :func:`moved_camera` of it)."""
-        uv, _ = project_with_jacobian(camera, posed[self.faces.ravel()])
-        tri = uv.reshape(-1, 3, 2)
-        area = ((tri[:, 1, 0] - tri[:, 0, 0]) * (tri[:, 2, 1] - tri[:, 0, 1])
-                - (tri[:, 2, 0] - tri[:, 0, 0]) * (tri[:, 1, 1] - tri[:, 0, 1]))
-        facing = area > 0
-        first, second = self.edges.faces[:, 0], self.edges.faces[:, 1]
-        silhouette = np.where(second < 0, True, facing[first] != facing[np.maximum(second, 0)])
-        edges = self.edges.vertices[silhouette]
-        # a third vertex of a face at the edge: both faces of a fold lie on its inner side
-        third = self.faces[self.edges.faces[silhouette, 0]].sum(axis=1) - edges.sum(axis=1)
-        ends, _ = project_with_jacobian(camera, posed[np.c_[edges, third].ravel()])
-        ends = ends.reshape(-1, 3, 2)
+        edges, ends = self._silhouette_edges(posed, camera)
         points = ends[:, :2].mean(axis=1)
         inside = self._inside(posed, camera)
         near = cv2.dilate(inside, _SQUARE) != cv2.erode(inside, _SQUARE)
@@ -248,6 +238,23 @@ class ViewOutline:
         return OutlineSamples(edges[outer], points[outer], lengths[outer],
                               self.model.vertex_parts[edges[outer, 0]].astype(int),
                               normals[outer])
+
+    def _silhouette_edges(self, posed: np.ndarray, camera: kernels.ViewCamera
+                          ) -> tuple[np.ndarray, np.ndarray]:
+        """The edges between a face turned to the camera and one turned away: their (E, 2)
+        vertices and (E, 3, 2) pixels of their two ends and of a third vertex of a face at
+        the edge (both faces of a fold lie on the edge's inner side)."""
+        uv, _ = project_with_jacobian(camera, posed[self.faces.ravel()])
+        tri = uv.reshape(-1, 3, 2)
+        area = ((tri[:, 1, 0] - tri[:, 0, 0]) * (tri[:, 2, 1] - tri[:, 0, 1])
+                - (tri[:, 2, 0] - tri[:, 0, 0]) * (tri[:, 1, 1] - tri[:, 0, 1]))
+        facing = area > 0
+        first, second = self.edges.faces[:, 0], self.edges.faces[:, 1]
+        silhouette = np.where(second < 0, True, facing[first] != facing[np.maximum(second, 0)])
+        edges = self.edges.vertices[silhouette]
+        third = self.faces[first[silhouette]].sum(axis=1) - edges.sum(axis=1)
+        ends, _ = project_with_jacobian(camera, posed[np.c_[edges, third].ravel()])
+        return edges, ends.reshape(-1, 3, 2)
 
     def _inside(self, posed: np.ndarray, camera: kernels.ViewCamera) -> np.ndarray:
         """(H, W) uint8: 1 where the body's raster covers the pixel (the search's renderer)."""
