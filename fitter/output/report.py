@@ -24,7 +24,7 @@ REPORT_PICTURES = {
     "outline_side": "Side: the person's silhouette (grey) with the fitted body's outline",
     "overlay_front": "Front: matched contours (overlay_front.png)",
     "overlay_side": "Side: matched contours (overlay_side.png)",
-    "convergence": "Best and mean cost per generation (convergence.png)",
+    "convergence": "The fit's cost per iteration or generation (convergence.png)",
 }
 
 _CSS = """
@@ -160,7 +160,7 @@ point's body part.</p>
 <p class="note">Bold: the paper's seven visually important measurements.</p>
 {_measurement_table(values, spreads)}
 
-<h2>Search</h2>
+<h2>Convergence</h2>
 <div class="row">{_figure("convergence", images)}</div>
 <div class="tables">
 <div><h3>Settings</h3><table>{_rows(_settings_rows(record))}</table></div>
