@@ -95,14 +95,16 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "hanging down, as the side photo shows them; hidden: without "
                              "arms (for a side photo whose arms hide within the torso)")
     parser.add_argument("--optimizer", choices=("ga", "cmaes"),
-                        help="cmaes: CMA-ES (default); ga: the paper's genetic algorithm")
-    parser.add_argument("--population", type=int, help="candidates per generation "
-                        "(default 30)")
+                        help="the population search's optimiser: cmaes, CMA-ES (default); "
+                             "ga, the paper's genetic algorithm")
+    parser.add_argument("--population", type=int, help="the population search's candidates "
+                        "per generation (default 30)")
     parser.add_argument("--generations", type=int,
-                        help="generations (default 150; --method paper: 25)")
+                        help="the population search's generations (default 150; --method "
+                             "paper: 25)")
     parser.add_argument("--components", type=int,
-                        help="shape components searched (default 20, as the paper; up to "
-                             "60)")
+                        help="shape components of the population search (default 20, as "
+                             "the paper; up to 60; the local solver solves for 40)")
     parser.add_argument("--seed", type=int, help="random seed (default 0)"
                         + ("; every subject uses it" if batch else ""))
     parser.add_argument("--searches", type=int,
@@ -153,7 +155,8 @@ def _build_parser() -> argparse.ArgumentParser:
         "build", help="build the body model from Anny into the cache (about 4 minutes; "
                       "bodyfit ships a default model, so this is for other settings)")
     build.add_argument("--components", type=int, default=60,
-                       help="PCA shape components to store (default 60; fitting uses 20)")
+                       help="PCA shape components to store (default 60; fitting uses 40, "
+                            "a population search 20)")
     build.add_argument("--samples", type=int, default=3000,
                        help="bodies in the sample, half men, half women (default 3000)")
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
