@@ -19,6 +19,7 @@ Frame and units everywhere: metres, model frame, z up, -y forward (the body face
 from __future__ import annotations
 
 import dataclasses
+import functools
 import io
 import json
 from pathlib import Path
@@ -110,9 +111,7 @@ class BodyModel:
                 f"the body model stores {self.num_components} shape components; "
                 f"asked for {num_components}. Rebuild it with `fitter model build --components N`."
             )
-        std = np.sqrt(self.eigenvalues[:num_components]).astype(np.float32)[:, None, None]
-        return (self.vertex_components[:num_components] * std,
-                self.joint_components[:num_components] * std)
+        return _scaled_directions(self, num_components)
 
     # ----------------------------------------------------------------- file I/O
     def save(self, path: Path) -> None:
@@ -187,6 +186,21 @@ class BodyModel:
                                 "run `fitter model build` to rebuild it")
         if self.faces.ndim != 2 or self.faces.shape[1] != 3 or self.faces.max() >= v:
             raise UserError("body model faces are inconsistent; run `fitter model build`")
+
+
+@functools.lru_cache(maxsize=8)
+def _scaled_directions(model: BodyModel, num_components: int) -> tuple[np.ndarray, np.ndarray]:
+    """:meth:`BodyModel.shape_directions`, computed once per model and K (read-only
+    arrays): a fit's forward passes ask for them hundreds of times (the local solver's
+    each iteration, the stature conditioner's each candidate), and scaling 40 components
+    of the mesh costs a few milliseconds each time. A model is hashed by its identity
+    (``eq=False``)."""
+    std = np.sqrt(model.eigenvalues[:num_components]).astype(np.float32)[:, None, None]
+    vertex_dirs = model.vertex_components[:num_components] * std
+    joint_dirs = model.joint_components[:num_components] * std
+    vertex_dirs.setflags(write=False)
+    joint_dirs.setflags(write=False)
+    return vertex_dirs, joint_dirs
 
 
 def _today_names(files: dict[str, np.ndarray], meta: dict) -> tuple[dict, dict]:
