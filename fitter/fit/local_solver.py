@@ -50,7 +50,7 @@ import scipy.ndimage as ndi
 from scipy.spatial import cKDTree
 
 from bodyfit.common.errors import UserError
-from bodyfit.fitter.fit.outline import ViewOutline, moved_camera
+from bodyfit.fitter.fit.outline import OutlineSamples, ViewOutline, moved_camera
 from bodyfit.fitter.model.body_model import BodyModel, forward
 from bodyfit import kernels
 
@@ -63,8 +63,8 @@ _KNEE_FALL = 0.8
 #: How far (metres, each axis) the solver may move a view's camera from where it was placed.
 _CAMERA_REACH_M = 0.5
 
-__all__ = ["SolverSettings", "SolverTrace", "silhouette_edge", "signed_distance", "sample_bilinear",
-           "LocalProblem", "solve", "moved_view"]
+__all__ = ["SolverSettings", "SolverTrace", "Residuals", "silhouette_edge", "signed_distance",
+           "sample_bilinear", "LocalProblem", "solve", "moved_view"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -100,8 +100,8 @@ class SolverSettings:
         if self.iterations < 0:
             raise UserError(f"--iterations must be >= 0, got {self.iterations}")
         if self.iterations and not 2 <= self.components <= stored_components:
-            raise UserError(f"--solver-components must be 2-{stored_components}, got "
-                            f"{self.components}")
+            raise UserError(f"the local solver's components must be 2-{stored_components}, "
+                            f"got {self.components}")
         if (self.prior < 0 or self.huber_mm <= 0 or self.placements < 0
                 or self.huber_start_mm < self.huber_mm):
             raise UserError("the solver's prior and placements must be >= 0 and its "
@@ -119,18 +119,12 @@ def silhouette_edge(mask: np.ndarray) -> np.ndarray:
     answers with a body too large."""
     level = cv2.GaussianBlur(np.asarray(mask, np.float64), (0, 0), _EDGE_SIGMA_PX,
                              borderType=cv2.BORDER_REPLICATE) - 0.5
-    points = []
-    for axis in (1, 0):  # along rows (columns change), then along columns
-        a = level
-        b = np.roll(level, -1, axis=axis)
-        crossing = (a > 0) != (b > 0)
-        if axis == 1:
-            crossing[:, -1] = False
-        else:
-            crossing[-1, :] = False
-        rows, cols = np.nonzero(crossing)
-        t = a[rows, cols] / (a[rows, cols] - b[rows, cols])
-        points.append(np.stack([cols + t * (axis == 1), rows + t * (axis == 0)], axis=1))
+    rows, cols = np.nonzero((level[:, :-1] > 0) != (level[:, 1:] > 0))  # along rows
+    t = level[rows, cols] / (level[rows, cols] - level[rows, cols + 1])
+    points = [np.stack([cols + t, rows], axis=1)]
+    rows, cols = np.nonzero((level[:-1] > 0) != (level[1:] > 0))  # along columns
+    t = level[rows, cols] / (level[rows, cols] - level[rows + 1, cols])
+    points.append(np.stack([cols, rows + t], axis=1))
     return np.concatenate(points)
 
 
@@ -181,6 +175,29 @@ class SolverTrace:
     genes: list[np.ndarray] = dataclasses.field(default_factory=list)
     evaluations: int = 0
     stop_reason: str = ""
+
+
+@dataclasses.dataclass
+class _ViewReading:
+    """What a view's residuals were read from: the body's outline samples, the camera
+    that saw them, and per term the sampled gradients of the person's signed distance
+    ((S, 2), model -> person) or each person edge point's nearest sample ((N,) indices,
+    person -> model); None where the term has no weight."""
+
+    samples: OutlineSamples
+    camera: kernels.ViewCamera
+    gradients: np.ndarray | None = None
+    nearest: np.ndarray | None = None
+
+
+@dataclasses.dataclass(frozen=True)
+class Residuals:
+    """A body's residuals: (S,) weights W and distances d (mm), every view's terms in
+    turn (model -> person, then person -> model), and the views' readings."""
+
+    weights: np.ndarray
+    distances: np.ndarray
+    readings: list[_ViewReading]
 
 
 class LocalProblem:
@@ -238,12 +255,12 @@ class LocalProblem:
         first = self.conditioner.complete(rows, np.repeat(pose[None], len(rows), 0))[:, 0]
         return (first[1:] - first[0]) / step
 
-    def residuals(self, x: np.ndarray, jacobian: bool = True):
-        """(weights W (S,), distances d (S,) mm, d d / d x (S, len(x)) or None) over every
-        view's outline samples."""
+    def residuals(self, x: np.ndarray) -> "Residuals":
+        """The residuals of the parameters ``x`` over every view's outline samples (one
+        render a view), with what :meth:`jacobian` needs of them."""
         betas, pose = self.body(x)
-        weights, distances, rows = [], [], []
-        slope = self._first_beta_slope(x) if jacobian else None
+        weights, distances, readings = [], [], []
+        share = 1.0 - self.settings.person_to_model
         for i, name in enumerate(self.names):
             outline = self.outlines[name]
             view = outline.view
@@ -251,47 +268,56 @@ class LocalProblem:
             first = self.num_genes + 3 * i
             camera = moved_camera(view.camera, x[first:first + 3])
             samples = outline.samples(posed.astype(np.float64), camera)
-            points = samples.points
-            mm = view.millimetres_per_pixel
-            view_weight = self.view_weights[name]
+            mm, view_weight = view.millimetres_per_pixel, self.view_weights[name]
             part_weights = self.part_weights[samples.parts]
-            share = 1.0 - self.settings.person_to_model
-            d_points = None
-            if jacobian:
-                d_pixels = outline.jacobian(samples, betas, pose, camera)  # (S, 2, K + 7)
-                d_points = np.zeros((len(points), 2, len(x)))
-                d_points[:, :, :self.num_genes] = np.concatenate(
-                    [d_pixels[:, :, 1:self.k] + d_pixels[:, :, :1] * slope[None, None],
-                     d_pixels[:, :, self.k:self.k + 4]], axis=2)
-                d_points[:, :, first:first + 3] = d_pixels[:, :, self.k + 4:]
+            reading = _ViewReading(samples, camera)
             if share > 0:  # model -> person: the person's signed distance at each sample
-                sd, grad = sample_bilinear(self.distance[name], points)
+                sd, reading.gradients = sample_bilinear(self.distance[name], samples.points)
                 lengths = samples.lengths / max(samples.lengths.sum(), 1e-9)
                 weights.append(share * view_weight * part_weights * lengths)
                 distances.append(mm * sd)
-                if jacobian:
-                    rows.append(mm * np.einsum("si,sik->sk", grad, d_points))
-            if share < 1:  # person -> model: each outline point to the nearest sample's edge
+            if share < 1:  # person -> model: each edge point to its nearest sample's edge
                 person = self.person_edges[name]
-                _, nearest = cKDTree(points).query(person)
-                normals = samples.normals[nearest]
-                gap = np.einsum("si,si->s", person - points[nearest], normals)
-                weights.append((1.0 - share) * view_weight * part_weights[nearest]
+                _, reading.nearest = cKDTree(samples.points).query(person)
+                gap = np.einsum("si,si->s", person - samples.points[reading.nearest],
+                                samples.normals[reading.nearest])
+                weights.append((1.0 - share) * view_weight * part_weights[reading.nearest]
                                / len(person))
                 distances.append(mm * gap)
-                if jacobian:
-                    rows.append(-mm * np.einsum("si,sik->sk", normals, d_points[nearest]))
-        return (np.concatenate(weights), np.concatenate(distances),
-                np.concatenate(rows) if jacobian else None)
+            readings.append(reading)
+        return Residuals(np.concatenate(weights), np.concatenate(distances), readings)
 
-    def cost(self, weights: np.ndarray, distances: np.ndarray, x: np.ndarray,
-             knee: float) -> float:
-        """The cost of the residuals (Huber's loss with its ``knee``, mm) plus the prior,
-        mm^2."""
-        a = np.abs(distances)
+    def jacobian(self, x: np.ndarray, residuals: "Residuals") -> np.ndarray:
+        """(S, len(x)) d distances (mm) / d ``x`` of ``residuals`` (:meth:`residuals` of
+        ``x``), rows in their order; no render."""
+        betas, pose = self.body(x)
+        slope = self._first_beta_slope(x)
+        rows = []
+        for i, (name, reading) in enumerate(zip(self.names, residuals.readings)):
+            outline = self.outlines[name]
+            mm = outline.view.millimetres_per_pixel
+            first = self.num_genes + 3 * i
+            d_pixels = outline.jacobian(reading.samples, betas, pose, reading.camera)
+            d_points = np.zeros((len(reading.samples.points), 2, len(x)))
+            d_points[:, :, :self.num_genes] = np.concatenate(
+                [d_pixels[:, :, 1:self.k] + d_pixels[:, :, :1] * slope[None, None],
+                 d_pixels[:, :, self.k:self.k + 4]], axis=2)
+            d_points[:, :, first:first + 3] = d_pixels[:, :, self.k + 4:]
+            if reading.gradients is not None:
+                rows.append(mm * np.einsum("si,sik->sk", reading.gradients, d_points))
+            if reading.nearest is not None:
+                normals = reading.samples.normals[reading.nearest]
+                rows.append(-mm * np.einsum("si,sik->sk", normals,
+                                            d_points[reading.nearest]))
+        return np.concatenate(rows)
+
+    def cost(self, residuals: Residuals, x: np.ndarray, knee: float) -> float:
+        """The cost of ``x``'s residuals (Huber's loss with its ``knee``, mm) plus the
+        prior, mm^2."""
+        a = np.abs(residuals.distances)
         rho = np.where(a <= knee, a * a, 2 * knee * a - knee * knee)
         betas = x[:self.k - 1]
-        return float(weights @ rho + self.settings.prior * betas @ betas)
+        return float(residuals.weights @ rho + self.settings.prior * betas @ betas)
 
 
 def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndarray, SolverTrace]:
@@ -313,28 +339,30 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
     damping = 1e-3
     prior = np.zeros(len(x))
     prior[:problem.k - 1] = s.prior
-    weights, distances, jac = problem.residuals(x)
+    residuals = problem.residuals(x)
+    jacobian = problem.jacobian(x, residuals)
     trace.evaluations += 1
     for iteration in range(s.iterations):
         if place is not None and iteration in at:
             place(*problem.body(x))
             x[problem.num_genes:] = 0.0  # the cameras stand where the placement put them
-            weights, distances, jac = problem.residuals(x)
+            residuals = problem.residuals(x)
+            jacobian = problem.jacobian(x, residuals)
             trace.evaluations += 1
         knee = max(s.huber_mm, s.huber_start_mm * _KNEE_FALL ** iteration)
-        cost = problem.cost(weights, distances, x, knee)
-        a = np.abs(distances)
-        reweight = weights * np.where(a <= knee, 1.0, knee / np.maximum(a, 1e-12))
-        normal = (jac * reweight[:, None]).T @ jac + np.diag(prior)
-        gradient = jac.T @ (reweight * distances) + prior * x
+        cost = problem.cost(residuals, x, knee)
+        a = np.abs(residuals.distances)
+        reweight = residuals.weights * np.where(a <= knee, 1.0, knee / np.maximum(a, 1e-12))
+        normal = (jacobian * reweight[:, None]).T @ jacobian + np.diag(prior)
+        gradient = jacobian.T @ (reweight * residuals.distances) + prior * x
         improved = False
         for _ in range(8):
             step = np.linalg.solve(normal + damping * np.diag(np.diag(normal) + 1e-9),
                                    -gradient)
             trial = np.clip(x + step, problem.lower, problem.upper)
-            t_weights, t_distances, _ = problem.residuals(trial, jacobian=False)
+            tried = problem.residuals(trial)
             trace.evaluations += 1
-            t_cost = problem.cost(t_weights, t_distances, trial, knee)
+            t_cost = problem.cost(tried, trial, knee)
             if t_cost < cost:
                 improved = True
                 damping = max(damping / 3, 1e-7)
@@ -343,10 +371,9 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
         if not improved:
             trace.stop_reason = "no step lowers the cost"
             break
-        x = trial
-        weights, distances, jac = problem.residuals(x)
-        trace.evaluations += 1
-        trace.costs.append(problem.cost(weights, distances, x, s.huber_mm))
+        x, residuals = trial, tried
+        jacobian = problem.jacobian(x, residuals)  # of the outline the trial already read
+        trace.costs.append(problem.cost(residuals, x, s.huber_mm))
         trace.genes.append(x[:problem.num_genes].copy())
         if ((cost - t_cost) < s.tolerance * cost and knee == s.huber_mm
                 and iteration + 1 not in at):

@@ -39,6 +39,7 @@ from bodyfit import kernels
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, rest_shape
 from bodyfit.kernels.body_forward import abduction_rotations, blend_skinning
 from bodyfit.kernels.body_layout import POSE_SIDES
+from bodyfit.kernels.raster import BACKGROUND, launch_projection, launch_raster
 from bodyfit.kernels.target import visible_faces
 from bodyfit.kernels.view_camera import camera_matrices
 
@@ -215,9 +216,14 @@ class ViewOutline:
     def __init__(self, model: BodyModel, view: kernels.ViewTarget):
         self.model = model
         self.view = view
-        self.faces, self.face_parts = visible_faces(model.faces, model.face_parts,
-                                                    view.visible_parts)
+        self.faces, face_parts = visible_faces(model.faces, model.face_parts,
+                                               view.visible_parts)
         self.edges = MeshEdges.of(self.faces)
+        # the raster's inputs and buffers on the CPU, made once: every iteration renders
+        self._raster_faces = wp.array(self.faces.astype(np.int32), dtype=wp.vec3i, device="cpu")
+        self._raster_parts = wp.array(face_parts.astype(np.int32), dtype=wp.int32, device="cpu")
+        self._screen = wp.empty((1, model.num_vertices), dtype=wp.vec3, device="cpu")
+        self._keys = wp.empty((1, view.height, view.width), dtype=wp.int32, device="cpu")
 
     def samples(self, posed: np.ndarray, camera: kernels.ViewCamera) -> OutlineSamples:
         """The outline of a body posed as this view renders it, (V, 3) metres, seen by
@@ -257,11 +263,12 @@ class ViewOutline:
         return edges, ends.reshape(-1, 3, 2)
 
     def _inside(self, posed: np.ndarray, camera: kernels.ViewCamera) -> np.ndarray:
-        """(H, W) uint8: 1 where the body's raster covers the pixel (the search's renderer)."""
-        view = self.view
-        labels = kernels.rasterize(posed[None].astype(np.float32), self.faces, self.face_parts,
-                                   camera, view.height, view.width).numpy()[0]
-        return (labels >= 0).astype(np.uint8)
+        """(H, W) uint8: 1 where the body's raster covers the pixel (the search's renderer,
+        :func:`bodyfit.kernels.rasterize`'s kernels on buffers kept from call to call)."""
+        vertices = wp.array(posed[None].astype(np.float32), dtype=wp.vec3, device="cpu")
+        launch_projection(camera, vertices, self._screen)
+        launch_raster(camera, self._screen, self._raster_faces, self._raster_parts, self._keys)
+        return (self._keys.numpy()[0] != BACKGROUND).astype(np.uint8)
 
     def _pixel(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(rows, columns) of the canvas pixels nearest (N, 2) points, clipped to it."""

@@ -357,18 +357,20 @@ def _canvas_components(settings: FitSettings) -> int:
 
 
 def _solved(model, views, masks, intrinsics, stature_m, settings: FitSettings,
-            first: SearchResult | None) -> SearchResult:
+            first: SearchResult | None, canvas_bodies: np.ndarray) -> SearchResult:
     """The local solver's answer (:mod:`bodyfit.fitter.fit.local_solver`), started from
     ``first``'s (the searches' answer) or from the mean body (None), the pinhole cameras
     placed anew from its body ``solver.placements`` times; joined to ``first`` by
     :func:`~bodyfit.fitter.fit.search.refined`. Updates ``views`` to the cameras as
     solved, and scores the answer with the search's cost there (its ``cost``, from which
-    the calibrated ± is read)."""
+    the calibrated ± is read). ``canvas_bodies``: the extreme bodies the canvases cover
+    (:func:`_canvas_components`'), the solver's own when it sets their components."""
     solver, s = settings.solver, settings.search
     began = time.perf_counter()
     at_k = dataclasses.replace(settings, search=dataclasses.replace(s, components=solver.components))
-    bodies = extreme_bodies(model, solver.components, s.pose_lower_deg, s.pose_upper_deg,
-                            settings.canvas.beta_limit)
+    bodies = canvas_bodies if _canvas_components(settings) == solver.components else \
+        extreme_bodies(model, solver.components, s.pose_lower_deg, s.pose_upper_deg,
+                       settings.canvas.beta_limit)
     evaluator, conditioner = _scoring(model, views, at_k, stature_m, bodies)
     problem = LocalProblem(render_model(model, settings.render_cell_mm), views, settings.cost,
                            conditioner, solver.components, s.pose_lower_deg, s.pose_upper_deg,
@@ -485,17 +487,18 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
         if s.refine_components:
             result = _refined(model, views, stature_m, result, settings, progress)
     if settings.solver.iterations:
-        result = _solved(model, views, masks, intrinsics, stature_m, settings, result)
+        result = _solved(model, views, masks, intrinsics, stature_m, settings, result,
+                         bodies)
     t2 = time.perf_counter()
     posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
                                              stature_m, s.condition_stature)
     measurer = Measurer.from_model(model)
     measurements = fitted_measurements(model, measurer, settings, rest, view_bodies, views,
                                        masks, intrinsics)
-    if calibration_applies(settings, METHODS["bodyfit"]):
-        spreads, basis = bodyfit_calibration().spreads(answer_cost(result)), "calibrated"
-    elif not s.searches:  # the solver alone: no population to measure
-        spreads, basis = bodyfit_calibration().spreads(answer_cost(result)), "solver"
+    calibrated = calibration_applies(settings, METHODS["bodyfit"])
+    if calibrated or not s.searches:  # the solver alone has no population to measure
+        spreads = bodyfit_calibration().spreads(answer_cost(result))
+        basis = "calibrated" if calibrated else "solver"
     else:
         spreads, basis = population_spreads(model, measurer, result, stature_m
                                             if s.condition_stature else None), "population"

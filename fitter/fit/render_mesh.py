@@ -23,6 +23,7 @@ longer arms (the arm length's error in-space 3.10 -> 2.59 mm with the hands left
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -36,9 +37,12 @@ CLUSTERED_PARTS = ("head", "foot")
 _EXTREME_BAND_M = 0.01
 
 
+@functools.lru_cache(maxsize=4)
 def render_model(model: BodyModel, cell_mm: float) -> BodyModel:
     """The model with ``CLUSTERED_PARTS`` clustered to ``cell_mm`` cubes (module docstring);
-    ``cell_mm`` 0 returns ``model`` itself.
+    ``cell_mm`` 0 returns ``model`` itself. Made once per model and cell (a fit asks for
+    it for its evaluators and its local solver, a batch for every subject; the same
+    object each time, so what is cached per model, its scaled shape directions, is too).
 
     Raises:
         ValueError: a negative cell size.
