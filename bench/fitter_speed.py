@@ -2,6 +2,7 @@
 
     python -m bench.fitter_speed SETS/in SETS/out --first 2
     python -m bench.fitter_speed SETS/in SETS/out --first 2 --device cuda:0
+    python -m bench.fitter_speed SETS/in SETS/out --first 2 --only bodyfit --plot OTHER.png
 
 Subjects: the first N rows of accuracy benchmark sets (``python -m bench.accuracy make``;
 in-space and out-of-space bodies photographed through a phone camera, calibrated into
@@ -67,28 +68,36 @@ def main() -> None:
     parser.add_argument("--plot", type=Path, default=Path("docs/fitter_error_vs_time.png"),
                         help="error-against-time plot to write")
     parser.add_argument("--device", default="cpu", help="`fitter run --device` (cpu, cuda:0)")
+    parser.add_argument("--only", metavar="PREFIX",
+                        help="only the settings whose name starts with PREFIX (bodyfit, "
+                             "thorough, paper)")
     args = parser.parse_args()
-    errors = {name: [] for name in SETTINGS}
-    seconds = {name: [] for name in SETTINGS}
+    settings = {name: options for name, options in SETTINGS.items()
+                if name.startswith(args.only or "")}
+    errors = {name: [] for name in settings}
+    seconds = {name: [] for name in settings}
     for set_folder in args.sets:
         for folder, truth in _subjects(set_folder, args.first):
-            fit_each_setting(folder, truth, SETTINGS,
+            fit_each_setting(folder, truth, settings,
                              ["--camera", str(set_folder / "camera.json"), "--device",
                               args.device], errors, seconds, photo_suffix=".jpg")
     keys = list(MEASUREMENTS)
     important = [keys.index(k) for k in IMPORTANT]
     count = len(next(iter(errors.values())))
     print(f"`python -m bench.fitter_speed {' '.join(map(str, args.sets))} --first {args.first}"
-          f"{'' if args.device == 'cpu' else ' --device ' + args.device}` on "
+          f"{'' if args.device == 'cpu' else ' --device ' + args.device}"
+          f"{'' if args.only is None else ' --only ' + args.only}` on "
           f"{time.strftime('%Y-%m-%d')}: {platform.machine()}, {os.cpu_count()} logical CPUs, "
           f"`fitter run --camera` on {args.device}, start-up included, {count} subjects.\n")
     print("\n".join(settings_table("setting", seconds, errors, np.median)))
-    mean7 = {name: np.abs(np.array(errors[name]))[:, important].mean() for name in SETTINGS}
-    chart = line_chart({curve: [mean7[n] for n in names] for curve, names in CURVES.items()},
+    mean7 = {name: np.abs(np.array(errors[name]))[:, important].mean() for name in settings}
+    curves = {curve: [n for n in names if n in settings] for curve, names in CURVES.items()}
+    curves = {curve: names for curve, names in curves.items() if names}
+    chart = line_chart({curve: [mean7[n] for n in names] for curve, names in curves.items()},
                        f"fitter run --camera, {count} subjects", "wall seconds per subject "
                        "(median)", "7 important measurements, mean abs. error (mm)",
                        log_y=True, x_values={curve: [np.median(seconds[n]) for n in names]
-                                             for curve, names in CURVES.items()})
+                                             for curve, names in curves.items()})
     write_image(args.plot, chart)
     print(f"\nPlot: `{args.plot}`.")
     sys.stdout.flush()
