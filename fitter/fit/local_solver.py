@@ -235,6 +235,11 @@ class LocalProblem:
         self.upper = np.r_[np.full(self.k - 1, beta_limit), pose_upper_deg,
                            np.full(3 * len(views), _CAMERA_REACH_M)]
 
+    def camera_moves(self, x: np.ndarray) -> dict[str, np.ndarray]:
+        """View name -> (3,) metres, the move of its camera in the parameters ``x``."""
+        return {name: x[self.num_genes + 3 * i:self.num_genes + 3 * i + 3]
+                for i, name in enumerate(self.names)}
+
     def replace_view(self, view: kernels.ViewTarget) -> None:
         """Score against ``view`` (the view of its name with its camera placed anew)."""
         self.outlines[view.name].view = view
@@ -261,12 +266,11 @@ class LocalProblem:
         betas, pose = self.body(x)
         weights, distances, readings = [], [], []
         share = 1.0 - self.settings.person_to_model
-        for i, name in enumerate(self.names):
+        for name, move in self.camera_moves(x).items():
             outline = self.outlines[name]
             view = outline.view
             posed = forward(self.model, betas[None], view.view_pose(pose[None]))[0]
-            first = self.num_genes + 3 * i
-            camera = moved_camera(view.camera, x[first:first + 3])
+            camera = moved_camera(view.camera, move)
             samples = outline.samples(posed.astype(np.float64), camera)
             mm, view_weight = view.millimetres_per_pixel, self.view_weights[name]
             part_weights = self.part_weights[samples.parts]

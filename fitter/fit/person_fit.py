@@ -367,7 +367,8 @@ def _solved(model, views, masks, intrinsics, stature_m, settings: FitSettings,
     (:func:`_canvas_components`'), the solver's own when it sets their components."""
     solver, s = settings.solver, settings.search
     began = time.perf_counter()
-    at_k = dataclasses.replace(settings, search=dataclasses.replace(s, components=solver.components))
+    at_k = dataclasses.replace(settings,
+                               search=dataclasses.replace(s, components=solver.components))
     bodies = canvas_bodies if _canvas_components(settings) == solver.components else \
         extreme_bodies(model, solver.components, s.pose_lower_deg, s.pose_upper_deg,
                        settings.canvas.beta_limit)
@@ -388,9 +389,8 @@ def _solved(model, views, masks, intrinsics, stature_m, settings: FitSettings,
 
     solved, trace = solve(problem, start, place if settings.projection == "pinhole" else None)
     betas, pose = problem.body(solved)
-    for i, name in enumerate(problem.names):
-        views[name] = moved_view(views[name], solved[problem.num_genes + 3 * i:
-                                                     problem.num_genes + 3 * i + 3])
+    for name, move in problem.camera_moves(solved).items():
+        views[name] = moved_view(views[name], move)
         evaluator.replace_view(views[name])
     scored = evaluator.evaluate(betas[None], pose[None])
     genes = np.array(trace.genes) if trace.genes else start[None]
