@@ -31,13 +31,17 @@ from bodyfit.calib.images import write_image
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.output.plots import line_chart
 
-#: name -> `fitter run` options: bodyfit's default (the local solver) at several
-#: iteration budgets, the population search that was the default before (``thorough``)
-#: at its full budget and at one search alone, and the paper's method at two budgets.
+#: name -> `fitter run` options: bodyfit's default (the local solver from the learned
+#: start) at several iteration budgets, the learned start alone, the solver from the mean
+#: body (the default before it), the population search that was the default before that
+#: (``thorough``) at its full budget and at one search alone, and the paper's method at
+#: two budgets.
 SETTINGS = {
+    "bodyfit: the learned start alone": ["--iterations", "0"],
     "bodyfit: 5 iterations": ["--iterations", "5"],
     "bodyfit: 10 iterations": ["--iterations", "10"],
     "bodyfit (default): 40 iterations": [],
+    "bodyfit from the mean body: 40 iterations": ["--start", "mean"],
     "thorough: one search 30 x 150": ["--method", "thorough", "--searches", "1",
                                       "--refine-components", "0"],
     "thorough (the default before)": ["--method", "thorough"],
@@ -45,10 +49,12 @@ SETTINGS = {
     "paper: GA 30 x 200": ["--method", "paper", "--generations", "200"],
 }
 #: The curves of the error-against-time plot: name -> the settings on it.
-CURVES = {family: [name for name in SETTINGS if name.startswith(prefix)]
-          for family, prefix in (("bodyfit (local solver)", "bodyfit"),
-                                 ("thorough (CMA-ES)", "thorough"),
-                                 ("paper (GA)", "paper"))}
+CURVES = {family: [name for name in SETTINGS if name.startswith(prefixes)]
+          for family, prefixes in (("bodyfit (local solver, learned start)",
+                                    ("bodyfit:", "bodyfit (default)")),
+                                   ("bodyfit from the mean body", ("bodyfit from",)),
+                                   ("thorough (CMA-ES)", ("thorough",)),
+                                   ("paper (GA)", ("paper",)))}
 
 
 def _subjects(set_folder: Path, first: int) -> list[tuple[Path, dict[str, float]]]:

@@ -33,12 +33,12 @@ import dataclasses
 import numpy as np
 
 from bodyfit.fitter.fit.side_arms import arms_down_angle
-from bodyfit.fitter.model.body_model import BodyModel, abduction_rotations, rest_shape
+from bodyfit.fitter.model.body_model import BodyModel, rest_shape
+from bodyfit.fitter.model.limb_bends import bent_bodies, flexion_rotations, turned_bodies
 from bodyfit.fitter.model_build.body_sample import BodySampler, SamplingSettings
-from bodyfit.kernels.body_forward import blend_skinning
 
 __all__ = ["KINDS", "SEXES", "Bodies", "bent_bodies", "draw_bodies", "flexion_rotations",
-           "pose_bodies", "turned_bodies"]
+           "pose_bodies", "turned_bodies"]  # the bends re-exported from the model
 
 KINDS = ("in-space", "out-of-space")
 SEXES = ("female", "male")
@@ -143,38 +143,6 @@ def _anny_bodies(model: BodyModel, per_sex: int, hard_per_sex: int, seed: int,
                 vertices.append(drawn[name].vertices[pick])
                 joints.append(drawn[name].joints[pick])
     return np.concatenate(vertices), np.concatenate(joints)
-
-
-def flexion_rotations(flexion_deg: np.ndarray) -> np.ndarray:
-    """(P, 4, 3, 3) rotations about each chain's x axis (the sagittal plane): a positive
-    angle swings a hanging limb forward (towards -y)."""
-    phi = np.deg2rad(np.asarray(flexion_deg, dtype=np.float64))
-    c, s = np.cos(phi), np.sin(phi)
-    rot = np.zeros(phi.shape + (3, 3))
-    rot[..., 0, 0] = 1.0
-    rot[..., 1, 1] = c
-    rot[..., 1, 2] = s
-    rot[..., 2, 1] = -s
-    rot[..., 2, 2] = c
-    return rot
-
-
-def turned_bodies(model: BodyModel, rest: np.ndarray, joints: np.ndarray,
-                  pose_deg: np.ndarray, turns: np.ndarray) -> np.ndarray:
-    """(P, V, 3) float32 metres: the rest body (V, 3), its rig joints (4, 3), posed by each
-    row of ``pose_deg`` (P, 4) abduction angles after the same row's ``turns``
-    (P, 4, 3, 3) rotations of each chain about its joint, ``POSE_NAMES`` order."""
-    count = len(pose_deg)
-    return blend_skinning(model.chain_weights, np.repeat(rest[None], count, 0),
-                          np.repeat(joints[None], count, 0),
-                          abduction_rotations(pose_deg) @ turns)
-
-
-def bent_bodies(model: BodyModel, rest: np.ndarray, joints: np.ndarray, pose_deg: np.ndarray,
-                flexion_deg: np.ndarray) -> np.ndarray:
-    """:func:`turned_bodies` turned by the (P, 4) ``flexion_deg`` bends
-    (:func:`flexion_rotations`)."""
-    return turned_bodies(model, rest, joints, pose_deg, flexion_rotations(flexion_deg))
 
 
 def pose_bodies(model: BodyModel, bodies: Bodies, index: int) -> tuple[np.ndarray, np.ndarray]:

@@ -73,7 +73,8 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     parser.add_argument("--background-side", metavar="PHOTO",
                         help="background plate, side view")
     parser.add_argument("--sex", choices=("female", "male", "unknown"),
-                        help="recorded with the run (default unknown)"
+                        help="the person's sex, read by the learned start (default "
+                             "unknown)"
                              + ("; for the rows without a sex" if batch else ""))
     parser.add_argument("--weights", metavar="PRESET|FILE.toml",
                         help="cost weights: bodyfit (Table 2 without the top and bottom "
@@ -114,6 +115,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     parser.add_argument("--iterations", type=int,
                         help="the local solver's iterations at most, after the searches "
                              "(default 40; 0: none; --method thorough and paper: 0)")
+    parser.add_argument("--start", choices=("mean", "learned"),  # local_solver.SOLVER_STARTS
+                        help="where the local solver starts without a search: mean (the "
+                             "default: the mean body) or learned (the body a regression "
+                             "reads off the silhouettes; with --iterations 0, the answer)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
                              "first K components, --refinements of them, averaged (more "
@@ -164,6 +169,17 @@ def _build_parser() -> argparse.ArgumentParser:
                        help="write the model here instead of the cache (.npz); "
                             "fitter/data/body_model.npz is the model bodyfit ships")
     model_sub.add_parser("info", help="print which model is used and how it was built")
+    train = model_sub.add_parser(
+        "train-start", help="train the learned start (--start learned) for the model in use "
+                            "on bodies it draws and photographs (about 10 minutes) into the "
+                            "cache; bodyfit ships one for its default model")
+    train.add_argument("--bodies", type=int, default=6000,
+                       help="bodies photographed front and side (default 6000; a tenth "
+                            "held out to measure it)")
+    train.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    train.add_argument("-o", "--output", type=Path,
+                       help="write the weights here instead of the cache (.npz); "
+                            "fitter/data/learned_start.npz is the start bodyfit ships")
 
     demo = sub.add_parser(
         "demo", help="the main job on a synthetic person: photos and board photos through "
@@ -260,7 +276,37 @@ def _cmd_model_build(args) -> None:
     print(f"wrote {path}")
 
 
+def _cmd_model_train_start(args) -> None:
+    from tqdm import tqdm
+
+    from bodyfit.common.files import check_writable_dir
+    from bodyfit.fitter.fit.learned_start import trained_start_path
+    from bodyfit.fitter.model.cache import load_model
+    from bodyfit.fitter.training.start_training import TrainingSettings, train_start
+
+    model = load_model()
+    settings = TrainingSettings(bodies=args.bodies, seed=args.seed)
+    settings.validate(model)
+    path = args.output or trained_start_path()
+    if path.suffix != ".npz":
+        raise UserError(f"-o takes a .npz path, got {path}")
+    check_writable_dir(path.parent)
+    t0 = time.perf_counter()
+    with tqdm(total=settings.bodies, unit="body", disable=args.quiet or None) as progress:
+        start = train_start(model, settings, progress)
+    start.save(path)
+    held = start.metadata["held_out"]
+    print(f"trained the learned start on {settings.bodies} bodies in "
+          f"{time.perf_counter() - t0:.0f} s; on the {held['bodies']} held out: the 7 "
+          f"important measurements {held['important_mean_abs_mm']:.1f} mm, components "
+          f"{held['components_rms_sigma']:.2f} sigma, angles {held['angles_rms_deg']:.1f} "
+          f"degrees (rms)")
+    print(f"wrote {path}")
+
+
 def _cmd_model_info(args) -> None:
+    from bodyfit.fitter.fit.learned_start import (active_start, active_start_path,
+                                                  trained_start_path)
     from bodyfit.fitter.model.cache import active_model_path, load_model, model_path
 
     t0 = time.perf_counter()
@@ -276,6 +322,11 @@ def _cmd_model_info(args) -> None:
           f"sample's variance)")
     print(f"  built from anny {meta['anny_version']} with {meta['settings']} "
           f"in {meta['timings_s']['total']:.0f} s")
+    start_path = active_start_path()
+    held = active_start(model).metadata["held_out"]
+    origin = "trained by you" if start_path == trained_start_path() else "shipped with bodyfit"
+    print(f"learned start ({origin}): {start_path}; on its {held['bodies']} held-out bodies "
+          f"the 7 important measurements {held['important_mean_abs_mm']:.1f} mm")
 
 
 def _cmd_demo(args) -> None:
@@ -283,12 +334,13 @@ def _cmd_demo(args) -> None:
 
     from bodyfit.fitter.demo.example import (DemoSettings, calibrate_scene, measurement_table,
                                              write_scene)
-    from bodyfit.fitter.fit.person_fit import fit_work
+    from bodyfit.fitter.fit.person_fit import METHODS, check_learned_start, fit_work
     from bodyfit.fitter.fit.spreads import SPREAD_NOTES
     from bodyfit.fitter.model.cache import load_model
     from bodyfit.fitter.run.results import run_person
 
     model = load_model()
+    check_learned_start(model, METHODS[args.method or "bodyfit"])
     scene = write_scene(model, args.output, DemoSettings(seed=args.seed))
     calibration, camera_path, coverage_path = calibrate_scene(scene)
     fx_true, fx = scene.camera.K[0, 0], calibration.camera.K[0, 0]
@@ -413,6 +465,7 @@ def _batch_jobs(args):
     from bodyfit.calib.camera import load_camera
     from bodyfit.fitter.batch.job import subject_job
     from bodyfit.fitter.batch.subjects import BadRow, read_subjects
+    from bodyfit.fitter.fit.person_fit import check_learned_start
     from bodyfit.fitter.model.cache import load_model
     from bodyfit.fitter.run.options import base_settings, fit_settings
 
@@ -428,7 +481,10 @@ def _batch_jobs(args):
     table = read_subjects(args.subjects)
     base, _ = base_settings(args.method, args.config)
     try:
-        fit_settings(base, options).validate(load_model().num_components)
+        model = load_model()
+        settings = fit_settings(base, options)
+        settings.validate(model.num_components)
+        check_learned_start(model, settings)
     except ValueError as exc:  # --matching
         raise UserError(str(exc)) from None
     jobs, bad_rows = {}, list(table.bad_rows)
@@ -525,7 +581,8 @@ def main(argv: list[str] | None = None) -> int:
     command = {"batch": _cmd_batch, "demo": _cmd_demo, "measure": _cmd_measure,
                "run": _cmd_run}.get(args.command)
     if args.command == "model":
-        command = {"build": _cmd_model_build, "info": _cmd_model_info}[args.model_command]
+        command = {"build": _cmd_model_build, "info": _cmd_model_info,
+                   "train-start": _cmd_model_train_start}[args.model_command]
     try:
         code = command(args)
     except UserError as exc:

@@ -10,6 +10,7 @@ population search), the fitted body and its measurements with their ±.
   derivatives;
 - :mod:`~bodyfit.fitter.fit.local_solver`: Levenberg-Marquardt on the outline against the
   person's edge (the default method);
+- :mod:`~bodyfit.fitter.fit.learned_start`: the solver's start read off the silhouettes;
 - :mod:`~bodyfit.fitter.fit.optimizers`: the ask/tell optimisers (the paper's GA, CMA-ES);
 - :mod:`~bodyfit.fitter.fit.search`: a search of shape and pose over the kernels' cost;
 - :mod:`~bodyfit.fitter.fit.stature`: every candidate solved to the person's stature;

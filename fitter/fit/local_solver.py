@@ -60,10 +60,13 @@ _EDGE_SIGMA_PX = 1.0
 _EDGE_BAND_PX = 4.0
 #: The Huber knee's fall per iteration (``SolverSettings.huber_start_mm``).
 _KNEE_FALL = 0.8
+#: Where the local solver starts (``SolverSettings.start``); the first is the default.
+SOLVER_STARTS = ("mean", "learned")
 #: How far (metres, each axis) the solver may move a view's camera from where it was placed.
 _CAMERA_REACH_M = 0.5
 
-__all__ = ["SolverSettings", "SolverTrace", "Residuals", "silhouette_edge", "signed_distance",
+__all__ = ["SOLVER_STARTS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
+           "signed_distance",
            "sample_bilinear", "LocalProblem", "solve", "moved_view"]
 
 
@@ -85,6 +88,10 @@ class SolverSettings:
         person_to_model: the share of the person -> model term in each view's cost (the
             rest is the model -> person term's).
         tolerance: stop when an accepted step lowers the cost by less than this share.
+        start: where it starts without a population search: ``"mean"``, the mean body
+            (its angles 0), or ``"learned"``, the body and angles the learned start reads
+            off the silhouettes (:mod:`bodyfit.fitter.fit.learned_start`; with 0
+            iterations, that body is the answer).
     """
 
     iterations: int = 0
@@ -95,6 +102,7 @@ class SolverSettings:
     placements: int = 3
     person_to_model: float = 0.5
     tolerance: float = 1e-5
+    start: str = "mean"
 
     def validate(self, stored_components: int) -> None:
         if self.iterations < 0:
@@ -108,6 +116,9 @@ class SolverSettings:
                             "Huber knees > 0, the first at least the last")
         if not 0 <= self.person_to_model <= 1:
             raise UserError(f"person_to_model must be in [0, 1], got {self.person_to_model}")
+        if self.start not in SOLVER_STARTS:
+            raise UserError(f"--start must be one of {', '.join(SOLVER_STARTS)}, "
+                            f"got {self.start!r}")
 
 
 def silhouette_edge(mask: np.ndarray) -> np.ndarray:

@@ -38,7 +38,8 @@ class PersonInputs:
         camera: camera.json from ``calib capture``, or None.
         mask_front, mask_side: the user's own silhouettes (white person on black), or None.
         background_front, background_side: background plates, or None.
-        sex: "female", "male" or "unknown" (recorded; not yet a prior of the search).
+        sex: "female", "male" or "unknown" (read by the learned start,
+            :mod:`bodyfit.fitter.fit.learned_start`).
     """
 
     front: str

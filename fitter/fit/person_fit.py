@@ -17,6 +17,7 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
                                        orthographic_view)
+from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
@@ -33,9 +34,10 @@ from bodyfit.fitter.measure.measurements import Measurer
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, forward, rest_shape
 from bodyfit.kernels.target import visible_vertices
 
-__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fit_work", "fitted_bodies",
-           "fitted_measurements", "person_views", "place_cameras", "placement_body",
-           "refinement_scoring", "stature_conditioner", "view_photos"]
+__all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fit_work",
+           "fitted_bodies", "fitted_measurements", "check_learned_start", "learned_genes", "person_views",
+           "place_cameras", "placement_body", "refinement_scoring", "stature_conditioner",
+           "view_photos"]
 
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
@@ -73,7 +75,7 @@ class FitSettings:
     """
 
     search: SearchSettings = SearchSettings(searches=0, refine_components=0)
-    solver: SolverSettings = SolverSettings(iterations=40)
+    solver: SolverSettings = SolverSettings(iterations=40, start="learned")
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="model_to_person",
@@ -86,14 +88,23 @@ class FitSettings:
     placement_rounds: int = 2
     photo_extents: bool = True
 
+    @property
+    def learned_start(self) -> bool:
+        """The fit starts from the learned start (no search)."""
+        return self.solver.start == "learned"
+
     def validate(self, stored_components: int) -> None:
         """Raise UserError for settings no person could be fitted with (one line, naming
         the option)."""
         self.search.validate(stored_components)
         self.solver.validate(stored_components)
-        if not (self.search.searches or self.solver.iterations):
-            raise UserError("--searches 0 needs the local solver (--iterations 1 or more)")
-        if self.solver.iterations and not self.search.condition_stature:
+        if not (self.search.searches or self.solver.iterations or self.learned_start):
+            raise UserError("--searches 0 needs the local solver (--iterations 1 or more) "
+                            "or --start learned")
+        if self.search.searches and self.solver.start != "mean":
+            raise UserError("--start learned needs --searches 0: after a search the solver "
+                            "starts from the search's answer")
+        if (self.solver.iterations or self.learned_start) and not self.search.condition_stature:
             raise UserError("the local solver holds the stature: --free-stature needs "
                             "--iterations 0 (a population search alone)")
         self.canvas.validate()
@@ -356,11 +367,33 @@ def _canvas_components(settings: FitSettings) -> int:
                settings.solver.components if settings.solver.iterations else 1)
 
 
-def _solved(model, views, masks, intrinsics, stature_m, settings: FitSettings,
+def check_learned_start(model: BodyModel, settings: FitSettings) -> None:
+    """Raise UserError (one line) if ``settings`` start from the learned start and its
+    weights are missing, corrupt or of another body model: checked before any work."""
+    if settings.learned_start:
+        active_start(model)
+
+
+def learned_genes(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float, sex: str,
+                  components: int) -> np.ndarray:
+    """(K - 1 + 4,) the local solver's genes (components 2..K, the four angles, degrees) as
+    the learned start reads them off the person
+    (:mod:`bodyfit.fitter.fit.learned_start`); components it does not predict are 0.
+
+    Raises:
+        UserError: its weights are missing, corrupt, or of another body model.
+    """
+    betas, pose = active_start(model).start(masks, stature_m, sex)
+    return np.r_[np.r_[betas, np.zeros(components)][:components - 1], pose]
+
+
+def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitSettings,
             first: SearchResult | None, canvas_bodies: np.ndarray) -> SearchResult:
     """The local solver's answer (:mod:`bodyfit.fitter.fit.local_solver`), started from
-    ``first``'s (the searches' answer) or from the mean body (None), the pinhole cameras
-    placed anew from its body ``solver.placements`` times; joined to ``first`` by
+    ``first``'s (the searches' answer), or without one from the mean body or the learned
+    start (:func:`learned_genes`, the cameras placed for it first; ``sex``: the person's,
+    or "unknown"), the pinhole cameras placed anew from its body ``solver.placements``
+    times; joined to ``first`` by
     :func:`~bodyfit.fitter.fit.search.refined`. Updates ``views`` to the cameras as
     solved, and scores the answer with the search's cost there (its ``cost``, from which
     the calibrated ± is read). ``canvas_bodies``: the extreme bodies the canvases cover
@@ -380,6 +413,9 @@ def _solved(model, views, masks, intrinsics, stature_m, settings: FitSettings,
     if first is not None:
         betas = np.r_[first.betas, np.zeros(solver.components)][:solver.components]
         start = np.r_[betas[1:], first.pose_deg]
+    elif settings.learned_start:
+        start = np.clip(learned_genes(model, masks, stature_m, sex, solver.components),
+                        problem.lower[:problem.num_genes], problem.upper[:problem.num_genes])
 
     def place(betas: np.ndarray, pose_deg: np.ndarray) -> None:
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
@@ -387,19 +423,25 @@ def _solved(model, views, masks, intrinsics, stature_m, settings: FitSettings,
         for view in views.values():
             problem.replace_view(view)
 
-    solved, trace = solve(problem, start, place if settings.projection == "pinhole" else None)
+    pinhole = settings.projection == "pinhole"
+    if settings.learned_start and pinhole:  # the cameras placed for the start's body
+        place(*problem.body(start))
+    solved, trace = solve(problem, start, place if pinhole else None)
     betas, pose = problem.body(solved)
     for name, move in problem.camera_moves(solved).items():
         views[name] = moved_view(views[name], move)
         evaluator.replace_view(views[name])
     scored = evaluator.evaluate(betas[None], pose[None])
     genes = np.array(trace.genes) if trace.genes else start[None]
+    # the solver's cost per iteration; with none (the learned start alone), the start's
+    costs = np.array(trace.costs or [problem.cost(problem.residuals(solved), solved,
+                                                  solver.huber_mm)])
     per_iteration = conditioner.complete(genes[:, :solver.components - 1],
                                          genes[:, solver.components - 1:])
     result = SearchResult(
         betas=betas, pose_deg=pose, cost=float(scored.costs[0]),
-        part_costs=scored.part_costs[0], best_costs=np.array(trace.costs or [np.nan]),
-        mean_costs=np.array(trace.costs or [np.nan]), best_betas=per_iteration,
+        part_costs=scored.part_costs[0], best_costs=costs, mean_costs=costs,
+        best_betas=per_iteration,
         final_genes=np.r_[betas, pose][None], final_costs=scored.costs[:1].astype(np.float64),
         evaluations=trace.evaluations, generations=len(trace.costs),
         seconds=time.perf_counter() - began, stop_reasons={"solver": trace.stop_reason})
@@ -457,7 +499,7 @@ def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSetti
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                settings: FitSettings = FitSettings(), progress: bool | None = None,
-               intrinsics: dict[str, np.ndarray] | None = None) -> Fit:
+               intrinsics: dict[str, np.ndarray] | None = None, sex: str = "unknown") -> Fit:
     """Fit the body model to a person's front and side silhouettes.
 
     Args:
@@ -469,6 +511,7 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
         intrinsics: {"front": K, "side": K}, (3, 3) pixels, of the upright photos the masks
             are of; needed by the pinhole projection
             (:func:`bodyfit.fitter.fit.person.view_intrinsics`).
+        sex: "female", "male" or "unknown": read by the learned start only.
     """
     settings.validate(model.num_components)
     if settings.projection == "pinhole" and intrinsics is None:
@@ -486,8 +529,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                            settings, progress)
         if s.refine_components:
             result = _refined(model, views, stature_m, result, settings, progress)
-    if settings.solver.iterations:
-        result = _solved(model, views, masks, intrinsics, stature_m, settings, result,
+    if settings.solver.iterations or settings.learned_start:
+        result = _solved(model, views, masks, intrinsics, stature_m, sex, settings, result,
                          bodies)
     t2 = time.perf_counter()
     posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
@@ -511,7 +554,8 @@ def fit_work(settings: FitSettings, result: SearchResult) -> str:
     """The work a fit did, in a few words (for the command line and the convergence plot)."""
     s = settings.search
     if not s.searches:
-        return (f"local solver, {result.generations} iterations "
+        start = " from the learned start" if settings.learned_start else ""
+        return (f"local solver{start}, {result.generations} iterations "
                 f"({result.evaluations} bodies rendered)")
     text = (f"{s.optimizer}: {result.evaluations} candidates"
             + (f", {s.searches} searches' mean" if s.searches > 1 else "")
@@ -529,4 +573,5 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
             (:func:`~bodyfit.fitter.fit.person.person_silhouettes`).
     """
     masks, intrinsics = person_silhouettes(inputs, settings.projection)
-    return fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics)
+    return fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics,
+                      inputs.sex)

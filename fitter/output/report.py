@@ -82,9 +82,12 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
     solver = record["settings"]["solver"]
     result = record["result"]
     default = "the optimiser's default"
+    learned = solver.get("start") == "learned"
     solver_row = ("local solver", f"{_e(solver['iterations'])} iterations at most, "
                                   f"{_e(solver['components'])} components"
-                  if solver["iterations"] else "none")
+                                  + (", from the learned start" if learned else "")
+                  if solver["iterations"] else
+                  "none: the learned start's body" if learned else "none")
     if not search["searches"]:
         return [("population search", "none"), solver_row,
                 ("ran", f"{result['generations']} iterations, {result['evaluations']} bodies "

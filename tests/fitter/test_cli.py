@@ -196,3 +196,23 @@ def test_measure_other_topology_exit_2(body_model, tmp_path, capsys):
 def test_bad_options_are_one_line_exit_2(capsys, argv, message):
     code, _, err = run(capsys, *argv)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("content", [b"garbage", None])
+def test_demo_with_a_corrupt_or_foreign_learned_start_exits_2(body_model, tmp_path, capsys,
+                                                               content):
+    import dataclasses
+
+    from bodyfit.fitter.fit.learned_start import (LearnedStart, shipped_start_path,
+                                                  trained_start_path)
+
+    path = trained_start_path()
+    if content is None:  # weights trained for another body model
+        start = LearnedStart.load(shipped_start_path())
+        dataclasses.replace(start, fingerprint="0" * 16).save(path)
+    else:
+        path.write_bytes(content)
+    code, _, err = run(capsys, "demo", "-o", str(tmp_path / "demo"))
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert ("corrupt" if content else "another body model") in err and "train-start" in err
+    assert not (tmp_path / "demo").exists()

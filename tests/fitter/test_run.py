@@ -188,7 +188,8 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--side-arms": "up"}, "invalid choice"),
     ({"--threads": "0"}, "--threads"),
     ({"--iterations": "-1"}, "--iterations must be >= 0"),
-    ({"--iterations": "0"}, "--searches 0 needs the local solver"),
+    ({"--iterations": "0", "--start": "mean"}, "--searches 0 needs the local solver"),
+    ({"--searches": "1", "--start": "learned"}, "--start learned needs --searches 0"),
     ({"swap": True}, "swapped"),
     ({"blank": True}, "no person"),
 ])
