@@ -114,7 +114,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "from the mean body; --method thorough: 2, paper: 1)")
     parser.add_argument("--iterations", type=int,
                         help="the local solver's iterations at most, after the searches "
-                             "(default 40; 0: none; --method thorough and paper: 0)")
+                             "(default 10; 0: none; --method thorough and paper: 0)")
     parser.add_argument("--start", choices=("mean", "learned"),  # local_solver.SOLVER_STARTS
                         help="where the local solver starts without a search: mean (the "
                              "default: the mean body) or learned (the body a regression "

@@ -35,9 +35,9 @@ from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, forward, rest
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fit_work",
-           "fitted_bodies", "fitted_measurements", "check_learned_start", "learned_genes", "person_views",
-           "place_cameras", "placement_body", "refinement_scoring", "stature_conditioner",
-           "view_photos"]
+           "fitted_bodies", "fitted_measurements", "check_learned_start", "learned_genes",
+           "person_views", "place_cameras", "placement_body", "refinement_scoring",
+           "stature_conditioner", "view_photos"]
 
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
@@ -75,7 +75,7 @@ class FitSettings:
     """
 
     search: SearchSettings = SearchSettings(searches=0, refine_components=0)
-    solver: SolverSettings = SolverSettings(iterations=40, start="learned")
+    solver: SolverSettings = SolverSettings(iterations=10, start="learned")
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="model_to_person",
@@ -104,7 +104,8 @@ class FitSettings:
         if self.search.searches and self.solver.start != "mean":
             raise UserError("--start learned needs --searches 0: after a search the solver "
                             "starts from the search's answer")
-        if (self.solver.iterations or self.learned_start) and not self.search.condition_stature:
+        solver = self.solver.iterations or self.learned_start
+        if solver and not self.search.condition_stature:
             raise UserError("the local solver holds the stature: --free-stature needs "
                             "--iterations 0 (a population search alone)")
         self.canvas.validate()
@@ -363,8 +364,9 @@ def _refined(model, views, stature_m, first: SearchResult, settings, progress) -
 def _canvas_components(settings: FitSettings) -> int:
     """The components whose extreme bodies the canvases cover: the search's, or the local
     solver's when it solves for more."""
+    solver = settings.solver.iterations or settings.learned_start
     return max(settings.search.components if settings.search.searches else 1,
-               settings.solver.components if settings.solver.iterations else 1)
+               settings.solver.components if solver else 1)
 
 
 def check_learned_start(model: BodyModel, settings: FitSettings) -> None:

@@ -58,11 +58,12 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     for key in MEASUREMENTS:
         assert truth[key] == pytest.approx(expected[key], abs=0.01)
     # the fit went through `fitter run --camera` with its default settings: the local
-    # solver over 40 components, no population search
+    # solver from the learned start over 40 components, no population search
     record = json.loads((out_dir / "fit" / "run.json").read_text())
     assert record["settings"]["projection"] == "pinhole"
     assert record["settings"]["search"]["searches"] == 0
-    assert record["settings"]["solver"]["iterations"] == 40
+    assert record["settings"]["solver"]["iterations"] == 10
+    assert record["settings"]["solver"]["start"] == "learned"
     assert len(record["result"]["betas"]) == 40
     assert record["inputs"]["camera"] == "demo/camera.json"
     written = json.loads((out_dir / "fit" / "measurements.json").read_text())

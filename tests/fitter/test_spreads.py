@@ -68,7 +68,7 @@ def test_calibration_applies_to_the_default_method_alone():
     assert not calibration_applies(METHODS["paper"], default)
     assert not calibration_applies(METHODS["thorough"], default)
     assert not calibration_applies(dataclasses.replace(
-        default, solver=dataclasses.replace(default.solver, iterations=10)), default)
+        default, solver=dataclasses.replace(default.solver, iterations=5)), default)
     assert not calibration_applies(dataclasses.replace(
         default, search=SearchSettings(refinements=4)), default)
     assert not calibration_applies(dataclasses.replace(default, projection="orthographic"),
