@@ -66,8 +66,7 @@ SOLVER_STARTS = ("mean", "learned")
 _CAMERA_REACH_M = 0.5
 
 __all__ = ["SOLVER_STARTS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
-           "signed_distance",
-           "sample_bilinear", "LocalProblem", "solve", "moved_view"]
+           "signed_distance", "sample_bilinear", "LocalProblem", "solve", "moved_view"]
 
 
 @dataclasses.dataclass(frozen=True)

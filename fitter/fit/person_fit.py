@@ -93,19 +93,23 @@ class FitSettings:
         """The fit starts from the learned start (no search)."""
         return self.solver.start == "learned"
 
+    @property
+    def solves(self) -> bool:
+        """The local solver runs: its iterations, or the learned start's body alone."""
+        return bool(self.solver.iterations) or self.learned_start
+
     def validate(self, stored_components: int) -> None:
         """Raise UserError for settings no person could be fitted with (one line, naming
         the option)."""
         self.search.validate(stored_components)
         self.solver.validate(stored_components)
-        if not (self.search.searches or self.solver.iterations or self.learned_start):
+        if not (self.search.searches or self.solves):
             raise UserError("--searches 0 needs the local solver (--iterations 1 or more) "
                             "or --start learned")
-        if self.search.searches and self.solver.start != "mean":
+        if self.search.searches and self.learned_start:
             raise UserError("--start learned needs --searches 0: after a search the solver "
                             "starts from the search's answer")
-        solver = self.solver.iterations or self.learned_start
-        if solver and not self.search.condition_stature:
+        if self.solves and not self.search.condition_stature:
             raise UserError("the local solver holds the stature: --free-stature needs "
                             "--iterations 0 (a population search alone)")
         self.canvas.validate()
@@ -364,9 +368,8 @@ def _refined(model, views, stature_m, first: SearchResult, settings, progress) -
 def _canvas_components(settings: FitSettings) -> int:
     """The components whose extreme bodies the canvases cover: the search's, or the local
     solver's when it solves for more."""
-    solver = settings.solver.iterations or settings.learned_start
     return max(settings.search.components if settings.search.searches else 1,
-               settings.solver.components if solver else 1)
+               settings.solver.components if settings.solves else 1)
 
 
 def check_learned_start(model: BodyModel, settings: FitSettings) -> None:
@@ -531,7 +534,7 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                            settings, progress)
         if s.refine_components:
             result = _refined(model, views, stature_m, result, settings, progress)
-    if settings.solver.iterations or settings.learned_start:
+    if settings.solves:
         result = _solved(model, views, masks, intrinsics, stature_m, sex, settings, result,
                          bodies)
     t2 = time.perf_counter()

@@ -270,7 +270,7 @@ def train_start(model: BodyModel, settings: TrainingSettings = TrainingSettings(
         "important_mean_abs_mm_each": dict(zip(IMPORTANT, np.abs(measured).mean(axis=0)
                                                .round(2).tolist())),
     }
-    settings_fields = {key: value for key, value in dataclasses.asdict(settings).items()}
-    return dataclasses.replace(start, metadata={"settings": settings_fields, "alpha": alpha,
+    return dataclasses.replace(start, metadata={"settings": dataclasses.asdict(settings),
+                                                "alpha": alpha,
                                                 "held_out": held_out,
                                                 "sex_codes": SEX_CODES})
