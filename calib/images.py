@@ -14,19 +14,20 @@ from __future__ import annotations
 
 import logging
 import math
-import struct
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
+from PIL import ExifTags, Image
 
 from bodyfit.calib.blur import edge_rise_px
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file, write_atomic
 
 __all__ = [
+    "FULL_FRAME_DIAGONAL_MM",
     "VIDEO_SUFFIXES",
     "Photo",
     "encode_image",
@@ -44,7 +45,13 @@ log = logging.getLogger(__name__)
 
 VIDEO_SUFFIXES = frozenset({".mp4", ".mov", ".m4v", ".avi", ".mkv", ".webm", ".mts", ".3gp"})
 
-_EXIF_ORIENTATION_TAG = 0x0112
+#: A full frame's (35 mm film) diagonal, mm: EXIF's FocalLengthIn35mmFilm is the focal
+#: length that gives the same field of view across it.
+FULL_FRAME_DIAGONAL_MM = 43.27
+_RESOLUTION_UNIT_MM = {2: 25.4, 3: 10.0, 4: 1.0, 5: 0.001}  # EXIF: inch, cm, mm, micrometre
+#: Fields of view (across the long side, degrees) an EXIF focal length may give; beyond,
+#: the tag is taken as wrong.
+_PLAUSIBLE_FOV_DEG = (15.0, 130.0)
 # Frames are ranked for sharpness at this width; the ranking only compares frames of one clip.
 _RANKING_WIDTH_PX = 640
 
@@ -56,32 +63,56 @@ class Photo:
     Attributes:
         pixels: (H, W, 3) uint8, BGR, sensor frame (EXIF orientation not applied).
         orientation: EXIF Orientation tag, 1..8 (1 when the file has none).
+        focal_px: the focal length EXIF states, in pixels of this photo (None: none stated).
+        focal_source: which EXIF tags stated it ("" when none did).
     """
 
     pixels: np.ndarray
     orientation: int
+    focal_px: float | None = None
+    focal_source: str = ""
 
 
-def _exif_orientation(exif: bytes) -> int:
-    """The Orientation tag (1..8) of a TIFF-structured EXIF block, 1 if absent or malformed."""
-    if exif.startswith(b"Exif\x00\x00"):
-        exif = exif[6:]
-    if len(exif) < 8 or exif[:2] not in (b"II", b"MM"):
-        return 1
-    order = "<" if exif[:2] == b"II" else ">"
-    (first_directory,) = struct.unpack_from(order + "I", exif, 4)
-    if first_directory + 2 > len(exif):
-        return 1
-    (entries,) = struct.unpack_from(order + "H", exif, first_directory)
-    for index in range(entries):
-        entry = first_directory + 2 + 12 * index
-        if entry + 12 > len(exif):
-            break
-        tag, value_type = struct.unpack_from(order + "HH", exif, entry)
-        if tag == _EXIF_ORIENTATION_TAG and value_type == 3:  # 3 = SHORT
-            (value,) = struct.unpack_from(order + "H", exif, entry + 8)
-            return value if 1 <= value <= 8 else 1
-    return 1
+def _exif_fields(exif: bytes, size_px: tuple[int, int]) -> tuple[int, float | None, str]:
+    """(orientation 1..8, focal length in sensor pixels or None, what stated it) of an EXIF
+    block (Pillow's reading; a malformed block or tag counts as absent).
+
+    The focal length, in the order a phone's JPEG states it: ``FocalLengthIn35mmFilm``
+    (scaled from a full frame's diagonal, :data:`FULL_FRAME_DIAGONAL_MM`, to the photo's
+    ``size_px`` (width, height) diagonal), else ``FocalLength`` with the sensor's size
+    (``FocalPlaneXResolution`` in ``FocalPlaneResolutionUnit``). A value that gives a
+    field of view outside :data:`_PLAUSIBLE_FOV_DEG` across the long side is ignored.
+    """
+    try:
+        tags = Image.Exif()
+        tags.load(exif)
+        orientation = int(tags.get(ExifTags.Base.Orientation, 1))
+        fields = tags.get_ifd(ExifTags.IFD.Exif)
+    except Exception:  # Pillow raises many kinds on a malformed block  # noqa: BLE001
+        return 1, None, ""
+    orientation = orientation if 1 <= orientation <= 8 else 1
+    focal, source = None, ""
+    try:
+        full_frame = float(fields.get(ExifTags.Base.FocalLengthIn35mmFilm, 0) or 0)
+        focal_mm = float(fields.get(ExifTags.Base.FocalLength, 0) or 0)
+        per_unit = float(fields.get(ExifTags.Base.FocalPlaneXResolution, 0) or 0)
+        unit_mm = _RESOLUTION_UNIT_MM.get(int(fields.get(
+            ExifTags.Base.FocalPlaneResolutionUnit, 2)), 0.0)
+    except (TypeError, ValueError, ZeroDivisionError):
+        return orientation, None, ""
+    if full_frame > 0:
+        focal = full_frame * math.hypot(*size_px) / FULL_FRAME_DIAGONAL_MM
+        source = f"EXIF FocalLengthIn35mmFilm {full_frame:g} mm"
+    elif focal_mm > 0 and per_unit > 0 and unit_mm > 0:
+        focal = focal_mm * per_unit / unit_mm
+        source = f"EXIF FocalLength {focal_mm:g} mm and the sensor's FocalPlaneXResolution"
+    if focal is not None:
+        fov = math.degrees(2 * math.atan(max(size_px) / 2 / focal))
+        if not _PLAUSIBLE_FOV_DEG[0] <= fov <= _PLAUSIBLE_FOV_DEG[1]:
+            log.warning("ignoring the photo's EXIF focal length (%s): %.0f degrees across "
+                        "is no phone's", source, fov)
+            focal, source = None, ""
+    return orientation, focal, source
 
 
 def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, list]:
@@ -102,13 +133,14 @@ def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, lis
 
 
 def read_photo(path: str | Path) -> Photo:
-    """Read a photo in the sensor frame, with its EXIF orientation; UserError if unreadable."""
+    """Read a photo in the sensor frame, with its EXIF orientation and focal length;
+    UserError if unreadable."""
     pixels, kinds, blocks = read_image_file(path, cv2.IMREAD_COLOR | cv2.IMREAD_IGNORE_ORIENTATION)
-    orientation = 1
     for kind, block in zip(np.asarray(kinds).reshape(-1), blocks):
         if kind == cv2.IMAGE_METADATA_EXIF:
-            orientation = _exif_orientation(np.asarray(block, np.uint8).tobytes())
-    return Photo(pixels, orientation)
+            size = (pixels.shape[1], pixels.shape[0])
+            return Photo(pixels, *_exif_fields(np.asarray(block, np.uint8).tobytes(), size))
+    return Photo(pixels, 1)
 
 
 def to_upright(image: np.ndarray, orientation: int) -> np.ndarray:

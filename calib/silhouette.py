@@ -94,7 +94,8 @@ class SilhouetteSettings:
             backdrop means the backdrop is not plain.
         median_px: side of the median filter's window, pixels (odd; 1 disables it).
         morphology_px: diameter of the disc for the opening and closing, pixels.
-        min_person_fraction: the person must cover at least this fraction of the image.
+        min_person_fraction: the person must cover at least this fraction of the image
+            (a side view from 4 m through a phone's main camera covers about 1 %).
         max_second_region_ratio: a second region at least this fraction of the largest
             means several people (or a large object) in the picture.
         outline_band_px: pixels either side of the outline that step 4 re-decides (0: none).
@@ -112,7 +113,7 @@ class SilhouetteSettings:
     max_border_foreground_fraction: float = 0.25
     median_px: int = 3
     morphology_px: int = 3
-    min_person_fraction: float = 0.02
+    min_person_fraction: float = 0.005
     max_second_region_ratio: float = 0.15
     outline_band_px: int = 2
     outline_window_px: int = 11
@@ -206,7 +207,7 @@ def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray
     if len(areas) == 0 or areas.max() < settings.min_person_fraction * height * width:
         raise UserError(
             "no person found: nothing in the photo differs from the backdrop over more than "
-            f"{settings.min_person_fraction:.0%} of the image; stand the person in front of the backdrop, "
+            f"{settings.min_person_fraction:.1%} of the image; stand the person in front of the backdrop, "
             "in clothes that do not match its colour"
         )
     largest = int(np.argmax(areas))

@@ -13,8 +13,10 @@ Two kinds (``KINDS``):
   local changes three times larger) before the same fit to ANSUR-like measurements.
   The K-component space reproduces none of them exactly. Needs the ``anny`` package and
   its data cache (about 1.1 GB, built on first use).
+- ``"standing"``: out-of-space bodies of another draw, posed as people stand by Anny's
+  whole skeleton (:mod:`.stances`): their Anny parameters are kept, for the photos.
 
-Poses: the front photo's four abduction angles are drawn uniformly from ``abduction_deg``;
+Poses of the first two kinds: the front photo's four abduction angles are drawn uniformly from ``abduction_deg``;
 out-of-space bodies also bend each limb forward or back by up to ``flexion_deg`` in the
 front photo, a motion the model's rig cannot make. The side photo hangs the arms down
 (shoulders at the body's own arms-down angle,
@@ -32,6 +34,7 @@ import dataclasses
 
 import numpy as np
 
+from bench.accuracy.stances import StanceSettings, draw_stances
 from bodyfit.fitter.fit.side_arms import arms_down_angle
 from bodyfit.fitter.model.body_model import BodyModel, rest_shape
 from bodyfit.fitter.model.limb_bends import bent_bodies, flexion_rotations, turned_bodies
@@ -40,7 +43,10 @@ from bodyfit.fitter.model_build.body_sample import BodySampler, SamplingSettings
 __all__ = ["KINDS", "SEXES", "Bodies", "bent_bodies", "draw_bodies", "flexion_rotations",
            "pose_bodies", "turned_bodies"]  # the bends re-exported from the model
 
-KINDS = ("in-space", "out-of-space")
+KINDS = ("in-space", "out-of-space", "standing")
+#: + the set's seed: seeds the model's own sample never used, so that none of these bodies
+#: was learned from, and the two kinds' bodies differ
+_ANNY_SEED = {"out-of-space": 1_000_003, "standing": 2_000_003}
 SEXES = ("female", "male")
 #: How much wider the out-of-space hard share's start distribution is.
 HARD_WIDEN = 3.0
@@ -56,6 +62,9 @@ class Bodies:
         vertices: (N, V, 3) float32, rest A-pose; joints: (N, 4, 3) float32, rig joints.
         abduction_deg: (N, 4) front photo's abduction angles, ``POSE_NAMES`` order.
         flexion_deg: (N, 4) each chain's forward (+) or backward bend, both photos.
+        anny_params: (N, D) float64 each body's Anny parameters (``SHAPE_PARAMETERS``
+            order; ``standing`` only, else (N, 0)).
+        stances: ``standing`` only, :func:`.stances.draw_stances`' arrays (else empty).
     """
 
     sex: np.ndarray
@@ -64,15 +73,19 @@ class Bodies:
     joints: np.ndarray
     abduction_deg: np.ndarray
     flexion_deg: np.ndarray
+    anny_params: np.ndarray
+    stances: dict[str, np.ndarray]
 
 
 def draw_bodies(model: BodyModel, kind: str, count: int, seed: int, *, num_components: int = 20,
                 hard_share: float = 0.2, abduction_deg: tuple[float, float] = (2.0, 8.0),
-                flexion_deg: float = 4.0, pool_per_sex: int = 400, progress=None) -> Bodies:
+                flexion_deg: float = 4.0, pool_per_sex: int = 400,
+                stance: StanceSettings = StanceSettings(), progress=None) -> Bodies:
     """``count`` bodies of ``kind`` (even: women and men alternately), reproducibly from
-    ``seed``. Out-of-space only: ``pool_per_sex``, the bodies the sampler's
+    ``seed``. Anny's kinds only: ``pool_per_sex``, the bodies the sampler's
     first linear map is fitted on (``SamplingSettings.pool_per_sex``; fewer is quicker
-    and fits the ANSUR targets less closely); ``progress``, a tqdm bar or None."""
+    and fits the ANSUR targets less closely); ``progress``, a tqdm bar or None.
+    ``standing`` only: ``stance``, its poses' ranges."""
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     if count < 2 or count % 2:
@@ -81,23 +94,27 @@ def draw_bodies(model: BodyModel, kind: str, count: int, seed: int, *, num_compo
     per_sex = count // 2
     sex = np.repeat(SEXES, per_sex)  # drawn women first, then interleaved (below)
     hard = np.zeros(count, bool)
+    params = np.zeros((count, 0))
     if kind == "in-space":
         vertices, joints = rest_shape(model, _in_space_betas(model, sex, num_components, rng))
         flexion = np.zeros((count, 4))
     else:
         hard_per_sex = int(round(per_sex * hard_share))
         hard[:hard_per_sex] = hard[per_sex:per_sex + hard_per_sex] = True
-        vertices, joints = _anny_bodies(model, per_sex, hard_per_sex, seed,
-                                        SamplingSettings(pool_per_sex=pool_per_sex),
-                                        progress)
+        vertices, joints, anny_params = _anny_bodies(
+            model, per_sex, hard_per_sex, _ANNY_SEED[kind] + seed,
+            SamplingSettings(pool_per_sex=pool_per_sex), progress)
         flexion = rng.uniform(-flexion_deg, flexion_deg, (count, 4))
+        if kind == "standing":
+            params = anny_params
     abduction = rng.uniform(*abduction_deg, (count, 4))
     # woman, man, woman, ... each sex in random order: any first 2n subjects are n women
     # and n men, with the hard share spread among them
     order = np.stack([rng.permutation(per_sex), per_sex + rng.permutation(per_sex)],
                      axis=1).ravel()
+    stances = draw_stances(stance, count, rng) if kind == "standing" else {}
     return Bodies(sex[order], hard[order], vertices[order], joints[order], abduction[order],
-                  flexion[order])
+                  flexion[order], params[order], stances)
 
 
 def _in_space_betas(model: BodyModel, sex: np.ndarray, num_components: int,
@@ -110,10 +127,10 @@ def _in_space_betas(model: BodyModel, sex: np.ndarray, num_components: int,
     return np.clip(betas, -3.0, 3.0)
 
 
-def _anny_bodies(model: BodyModel, per_sex: int, hard_per_sex: int, seed: int,
+def _anny_bodies(model: BodyModel, per_sex: int, hard_per_sex: int, base: int,
                  settings: SamplingSettings, progress):
-    """(vertices, joints) of full Anny bodies, women then men, each sex's hard share
-    first (module docstring)."""
+    """(vertices, joints, Anny parameters) of full Anny bodies, women then men, each sex's
+    hard share first (module docstring), drawn from seeds ``base``, ``base + 1``."""
     from bodyfit.fitter.measure.measurements import Measurer
     from bodyfit.fitter.model_build.anny_source import AnnySource
     class WideSampler(BodySampler):
@@ -125,8 +142,6 @@ def _anny_bodies(model: BodyModel, per_sex: int, hard_per_sex: int, seed: int,
         raise ValueError("the body model's mesh is not this Anny version's: rebuild it with "
                          "`fitter model build`")
     measurer = Measurer.from_model(model)
-    # another seed than the model's sample, so none of these bodies was learned from
-    base = 1_000_003 + seed
     drawn = {}
     for name, sampler_class, counts in (
             ("hard", WideSampler, hard_per_sex),
@@ -135,14 +150,10 @@ def _anny_bodies(model: BodyModel, per_sex: int, hard_per_sex: int, seed: int,
             sampler = sampler_class(source, measurer, settings)
             drawn[name] = sampler.sample({"male": counts, "female": counts},
                                          seed=base + len(drawn), progress=progress)
-    vertices, joints = [], []
-    for sex in SEXES:
-        for name in ("hard", "usual"):
-            if name in drawn:
-                pick = drawn[name].sex == sex
-                vertices.append(drawn[name].vertices[pick])
-                joints.append(drawn[name].joints[pick])
-    return np.concatenate(vertices), np.concatenate(joints)
+    parts = [(drawn[name], drawn[name].sex == sex) for sex in SEXES
+             for name in ("hard", "usual") if name in drawn]
+    return tuple(np.concatenate([getattr(sample, field)[pick] for sample, pick in parts])
+                 for field in ("vertices", "joints", "params"))
 
 
 def pose_bodies(model: BodyModel, bodies: Bodies, index: int) -> tuple[np.ndarray, np.ndarray]:

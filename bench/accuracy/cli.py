@@ -5,6 +5,7 @@ Run from the repository root (docs/accuracy.md holds what they measured)::
     # a subject set: bodies, photos through a phone camera, chessboard photos, the table
     python -m bench.accuracy make SETS/in --kind in-space --count 200 --seed 0
     python -m bench.accuracy make SETS/out --kind out-of-space --count 200 --seed 0
+    python -m bench.accuracy make SETS/standing --kind standing --count 200 --seed 0
     # fit it as a user would: calib capture on the board photos, then fitter batch with
     # the calibrated camera (fitter batch options after --; resumable: rerun to continue)
     python -m bench.accuracy fit SETS/in bodyfit
@@ -61,7 +62,7 @@ from bench.accuracy.report import (failure_lines, important_table, measurement_t
                                    paired_measurement_table)
 from bench.accuracy.runs import concatenated, joined_scores, keep_run, source_timing, subset
 from bench.accuracy.scores import KEYS, RunScores
-from bench.accuracy.subject_set import (BOARD, SQUARE_MM, SetSettings, read_bodies,
+from bench.accuracy.subject_set import (BOARD, CAMERA_FILE, SQUARE_MM, SetSettings, read_bodies,
                                         read_settings, subject_ids, write_bodies,
                                         write_photos_of_set)
 from bodyfit.calib.images import write_image
@@ -88,8 +89,10 @@ def make(args) -> None:
     folder = Path(args.set)
     model = load_model()
     if not (folder / "bodies.npz").exists():
-        settings = SetSettings(kind=args.kind, count=args.count, seed=args.seed,
-                               pool_per_sex=args.pool_per_sex)
+        settings = (SetSettings.standing(args.count, args.seed, pool_per_sex=args.pool_per_sex)
+                    if args.kind == "standing" else
+                    SetSettings(kind=args.kind, count=args.count, seed=args.seed,
+                                pool_per_sex=args.pool_per_sex))
         folder.mkdir(parents=True, exist_ok=True)
         write_bodies(model, folder, settings)
         print(f"{folder}: {args.count} {args.kind} bodies drawn")
@@ -146,7 +149,7 @@ def fit(args, batch_options: list[str]) -> None:
     folder = Path(args.set)
     if not (folder / "subjects.csv").exists():
         sys.exit(f"{folder}: not a subject set (no subjects.csv); make it with `make` first")
-    camera = folder / "camera.json"
+    camera = folder / CAMERA_FILE
     if args.camera == "calibrated" and not camera.exists():
         photos = sorted(str(p) for p in (folder / "board").glob("*.png"))
         subprocess.run([_command("calib"), "capture", *photos, "--board", BOARD, "--square-mm",
@@ -158,8 +161,11 @@ def fit(args, batch_options: list[str]) -> None:
         table = folder / (f"subjects-rows{args.skip}-{args.first - 1}.csv" if args.skip
                           else f"subjects-first{args.first}.csv")
         table.write_text("".join(_table_rows(folder, args.first, True, args.skip)))
+    # a table with a camera column names each subject's camera itself (standing sets)
+    per_row = "camera" in (folder / "subjects.csv").read_text().splitlines()[0].split(",")
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
-               *(["--camera", str(camera)] if args.camera == "calibrated" else []),
+               *(["--camera", str(camera)] if args.camera == "calibrated" and not per_row
+                 else []),
                *batch_options]
     earlier = {name: read_table(out / name, ("id",)) for name in (SUMMARY_FILE, FAILURES_FILE)}
     start = time.perf_counter()

@@ -63,7 +63,8 @@ class FitPhotos:
         inputs = PersonInputs(**given | {
             view: str(folder / subject / Path(given[view]).name) for view in ("front", "side")}
             | ({"camera": str(folder / Path(given["camera"]).name)} if given["camera"] else {}))
-        masks, intrinsics = person_silhouettes(inputs, settings.projection)
+        photos = person_silhouettes(inputs, settings.projection)
+        masks, intrinsics = photos.masks, photos.intrinsics
         s = settings.search
         stature_m = inputs.height_cm / 100.0
         views = person_views(model, masks, stature_m, settings, intrinsics,

@@ -14,13 +14,29 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from PIL import ExifTags, Image
 
 from bodyfit.calib.camera import Camera
 from bodyfit.common.files import write_atomic
 from bodyfit.fitter.demo.studio_photos import lens_photo
 from bodyfit.fitter.model.body_model import PART_NAMES, BodyModel
 
-__all__ = ["PhotoEffects", "record", "write_photos"]
+__all__ = ["PhotoEffects", "Shot", "exif_focal", "record", "write_photos"]
+
+#: A full-frame (35 mm film) diagonal, mm: EXIF's FocalLengthIn35mmFilm scales by it.
+FULL_FRAME_DIAGONAL_MM = 43.27
+#: The phone sensor's diagonal assumed for EXIF's FocalLength, mm (a 1/1.7" sensor).
+_SENSOR_DIAGONAL_MM = 9.5
+
+
+@dataclasses.dataclass(frozen=True)
+class Shot:
+    """Where one photo was taken from: ``distance_m`` from the body's vertical axis,
+    ``camera_height_m`` above the floor, pitched ``pitch_deg`` (positive looks down)."""
+
+    distance_m: float
+    camera_height_m: float
+    pitch_deg: float = 0.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -41,8 +57,25 @@ class PhotoEffects:
     jpeg_quality: int = 90
 
 
-def record(image: np.ndarray, effects: PhotoEffects, rng: np.random.Generator) -> bytes:
-    """JPEG bytes of ``image`` (H, W, 3) uint8 BGR after uneven light and sensor noise."""
+def exif_focal(camera: Camera) -> bytes:
+    """An EXIF block (``Exif\\0\\0`` and its TIFF structure) that says ``camera``'s focal
+    length as a phone writes it: FocalLengthIn35mmFilm, the focal length scaled from the
+    photo's diagonal to a full frame's and rounded to a millimetre, and FocalLength in mm
+    on a sensor of :data:`_SENSOR_DIAGONAL_MM`."""
+    width, height = camera.image_size_px
+    full_frame_mm = camera.K[0, 0] * FULL_FRAME_DIAGONAL_MM / np.hypot(width, height)
+    exif = Image.Exif()
+    fields = exif.get_ifd(ExifTags.IFD.Exif)
+    fields[ExifTags.Base.FocalLengthIn35mmFilm] = int(round(full_frame_mm))
+    fields[ExifTags.Base.FocalLength] = round(
+        full_frame_mm * _SENSOR_DIAGONAL_MM / FULL_FRAME_DIAGONAL_MM, 2)
+    return exif.tobytes()
+
+
+def record(image: np.ndarray, effects: PhotoEffects, rng: np.random.Generator,
+           exif: bytes = b"") -> bytes:
+    """JPEG bytes of ``image`` (H, W, 3) uint8 BGR after uneven light and sensor noise,
+    with the EXIF block ``exif`` (:func:`exif_focal`) if given."""
     h, w = image.shape[:2]
     y, x = np.mgrid[0:h, 0:w].astype(np.float32)
     x, y = (x - w / 2) / (w / 2), (y - h / 2) / (h / 2)  # -1..1
@@ -54,20 +87,19 @@ def record(image: np.ndarray, effects: PhotoEffects, rng: np.random.Generator) -
                             [cv2.IMWRITE_JPEG_QUALITY, effects.jpeg_quality])
     if not ok:
         raise RuntimeError("OpenCV could not encode a JPEG")
-    return data.tobytes()
+    data = data.tobytes()
+    if exif:  # an APP1 segment right after the start-of-image marker
+        data = data[:2] + b"\xff\xe1" + (len(exif) + 2).to_bytes(2, "big") + exif + data[2:]
+    return data
 
 
-def write_photos(folder: Path, model: BodyModel, front: np.ndarray, side: np.ndarray,
-                 camera: Camera, distance_m: float, camera_height_m: float,
-                 effects: PhotoEffects, rng: np.random.Generator) -> tuple[Path, Path]:
-    """Write front.jpg and side.jpg of the posed bodies ``front`` and ``side`` (V, 3)
-    metres into ``folder``, both from ``distance_m`` and ``camera_height_m``; return
-    their paths."""
-    paths = []
-    for view, vertices in (("front", front), ("side", side)):
-        image = lens_photo(vertices, model, view, PART_NAMES, camera, distance_m,
-                           camera_height_m)
-        path = Path(folder) / f"{view}.jpg"
-        write_atomic(path, record(image, effects, rng))
-        paths.append(path)
-    return paths[0], paths[1]
+def write_photos(folder: Path, model: BodyModel, posed: dict[str, np.ndarray],
+                 camera: Camera, shots: dict[str, Shot], effects: PhotoEffects,
+                 rng: np.random.Generator, exif: bytes = b"") -> None:
+    """Write front.jpg and side.jpg of the posed bodies ``posed`` ("front", "side" ->
+    (V, 3) metres) into ``folder``, each from its ``shots`` place, with ``exif``."""
+    for view in ("front", "side"):
+        shot = shots[view]
+        image = lens_photo(posed[view], model, view, PART_NAMES, camera, shot.distance_m,
+                           shot.camera_height_m, (shot.pitch_deg, 0.0))
+        write_atomic(Path(folder) / f"{view}.jpg", record(image, effects, rng, exif))

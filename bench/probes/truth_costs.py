@@ -68,7 +68,8 @@ def compare_costs(model: BodyModel, run_json: Path, vertices: np.ndarray,
     record = json.loads(Path(run_json).read_text())
     config = run_config(record, str(run_json))
     settings, inputs, result = config.settings, config.inputs, record["result"]
-    masks, intrinsics = person_silhouettes(inputs, settings.projection)
+    photos = person_silhouettes(inputs, settings.projection)
+    masks, intrinsics = photos.masks, photos.intrinsics
     stature_m = inputs.height_cm / 100.0
     s = settings.search
     if not s.refine_components:  # score in the search's own space

@@ -361,6 +361,7 @@ def _cmd_demo(args) -> None:
     result = fit.search
     print(f"fitted in {sum(fit.seconds.values()):.1f} s: {fit_work(settings, result)}, "
           f"{settings.projection}")
+    print(_photos_line(fit))
     print("\n".join(measurement_table(fit.measurements, fit.spreads, scene.truth)))
     print(f"  ({SPREAD_NOTES[fit.spread_basis]})")
     print("wrote:")
@@ -368,6 +369,12 @@ def _cmd_demo(args) -> None:
                  coverage_path, scene.truth_file, *written):
         print(f"  {path}")
     print(f"fit the photos again by hand: fitter {shlex.join(run_argv)}")
+
+
+def _photos_line(fit) -> str:
+    """What was read of the photos besides the silhouettes, for the summary."""
+    return (f"  camera: {fit.photos['camera']}; the side photo shows the person's "
+            f"{fit.photos['side_from']} side")
 
 
 def _run_settings(args):
@@ -412,6 +419,7 @@ def _cmd_run(args) -> None:
     result = fit.search
     print(f"fitted in {sum(fit.seconds.values()):.1f} s: {fit_work(settings, result)}, "
           f"cost {result.cost:.1f} weighted mm")
+    print(_photos_line(fit))
     for key, (_, label) in MEASUREMENTS.items():
         print(f"  {key} {label:<28} {fit.measurements[key]:8.1f} ± "
               f"{fit.spreads[key]:5.1f} mm")

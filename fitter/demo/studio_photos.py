@@ -69,7 +69,8 @@ def photo(vertices, model, view: str, parts, body_px: int = 700,
 
 def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
                   size_px: tuple[int, int], distance_m: float,
-                  camera_height_m: float) -> np.ndarray:
+                  camera_height_m: float, tilt_deg: tuple[float, float] = (0.0, 0.0)
+                  ) -> np.ndarray:
     """(H, W, 3) uint8 BGR photo of posed ``vertices`` (V, 3) metres through a pinhole.
 
     Args:
@@ -77,12 +78,13 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
         intrinsics: (3, 3) K, pixels; size_px: (width, height).
         distance_m: from the camera to the body's vertical axis (model origin).
         camera_height_m: the camera above the floor (the body's lowest vertex).
+        tilt_deg: (pitch, roll) of the camera held askew (``Placement``'s), degrees.
 
     The person's pixels are those the body covers by more than half
     (:func:`pinhole_silhouette`).
     """
     faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
-    rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m)
+    rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m, tilt_deg)
     image = render_pinhole(vertices, faces, face_parts, intrinsics, rotation, translation,
                            size_px)
     body = _covered(vertices, faces, intrinsics, rotation, translation, size_px)
@@ -109,11 +111,11 @@ def _covered(vertices, faces, intrinsics, rotation, translation, size_px) -> np.
                          size_px)
 
 
-def _extrinsics(vertices: np.ndarray, view: str, distance_m: float,
-                camera_height_m: float) -> tuple[np.ndarray, np.ndarray]:
+def _extrinsics(vertices: np.ndarray, view: str, distance_m: float, camera_height_m: float,
+                tilt_deg: tuple[float, float] = (0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
     """(rotation (3, 3), translation (3,) metres) of :func:`pinhole_photo`'s camera."""
     floor = float(vertices[:, 2].min())
-    return Placement(distance_m, camera_height_m, 0.0, -floor).extrinsics(view)
+    return Placement(distance_m, camera_height_m, 0.0, -floor, *tilt_deg).extrinsics(view)
 
 
 __all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "pinhole_silhouette", "lens_photo",
@@ -170,13 +172,14 @@ def write_pinhole_photos(folder, model, betas, pose_deg, camera: Camera, distanc
 
 
 def lens_photo(vertices, model, view: str, parts, camera: Camera, distance_m: float,
-               camera_height_m: float) -> np.ndarray:
+               camera_height_m: float, tilt_deg: tuple[float, float] = (0.0, 0.0)
+               ) -> np.ndarray:
     """(H, W, 3) uint8 BGR: :func:`pinhole_photo` of posed ``vertices`` (V, 3) metres
     through ``camera.K`` at ``camera.image_size_px``, recorded through the lens's
     distortion ``camera.dist`` (:func:`bodyfit.calib.synthetic.distort_image`; the
     backdrop fills where the lens sees beyond the pinhole picture)."""
     image = pinhole_photo(np.asarray(vertices, np.float64), model, view, parts, camera.K,
-                          camera.image_size_px, distance_m, camera_height_m)
+                          camera.image_size_px, distance_m, camera_height_m, tilt_deg)
     if np.any(camera.dist):
         image = distort_image(image, camera.K, camera.dist, BACKDROP_BGR)
     return image

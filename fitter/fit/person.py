@@ -4,6 +4,12 @@ Photos go through calib: read in the sensor frame, silhouette on the plain backd
 (optionally against a background plate), undistorted with the camera when one is given,
 turned upright by EXIF (:func:`bodyfit.calib.silhouette.photo_silhouette`). A user's
 mask replaces the extraction; it must be of the undistorted, upright photo.
+
+The side photo may show either side of the person: one taken from the person's right
+(told by :func:`bodyfit.fitter.fit.facing.side_seen`) is mirrored, mask and camera, into
+the photo from the left the fit expects. The camera: camera.json when given; else the
+focal length the photos' EXIF states; else a typical phone's (:class:`PersonPhotos`
+records which).
 """
 
 from __future__ import annotations
@@ -17,10 +23,12 @@ from bodyfit.calib.images import read_photo
 from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
-from bodyfit.fitter.fit.pinhole_canvas import phone_intrinsics, upright_intrinsics
+from bodyfit.fitter.fit.facing import side_seen
+from bodyfit.fitter.fit.pinhole_canvas import (PHONE_HFOV_DEG, phone_intrinsics,
+                                               upright_intrinsics)
 
-__all__ = ["PersonInputs", "STATURE_RANGE_CM", "person_masks", "view_intrinsics",
-           "person_silhouettes"]
+__all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "person_masks",
+           "view_intrinsics", "person_silhouettes"]
 
 #: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
 #: most likely given in other units).
@@ -72,7 +80,8 @@ def _view_mask(photo: str, mask: str | None, background: str | None, camera) -> 
 
 
 def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
-    """{"front": mask, "side": mask}: (H, W) bool silhouettes of the upright photos.
+    """{"front": mask, "side": mask}: (H, W) bool silhouettes of the upright photos, as
+    they are (the side one not mirrored).
 
     Raises:
         UserError: unreadable files, no person, several people, a person cut by the frame,
@@ -97,17 +106,31 @@ def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
     return masks
 
 
-def view_intrinsics(inputs: PersonInputs, masks: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """{"front": K, "side": K}: (3, 3) pixels, the camera matrix of each upright photo.
+def view_intrinsics(inputs: PersonInputs, masks: dict[str, np.ndarray]
+                    ) -> tuple[dict[str, np.ndarray], str]:
+    """({"front": K, "side": K}: (3, 3) pixels, the camera matrix of each upright photo;
+    where it came from, in a few words).
 
     camera.json's K turned as the photo's EXIF orientation turns it upright; without
-    camera.json, a typical phone's (:func:`bodyfit.fitter.fit.pinhole_canvas.phone_intrinsics`).
+    camera.json, the focal length the photo's EXIF states (principal point at the
+    centre), else a typical phone's
+    (:func:`bodyfit.fitter.fit.pinhole_canvas.phone_intrinsics`).
 
     Raises:
         UserError: a mirrored photo, or a mask of another size than the upright photo.
     """
     if inputs.camera is None:
-        return {view: phone_intrinsics(mask.shape) for view, mask in masks.items()}
+        found, stated = {}, {}
+        for view, mask in masks.items():
+            photo = read_photo(getattr(inputs, view))
+            found[view] = phone_intrinsics(mask.shape)
+            if photo.focal_px is not None:
+                found[view][0, 0] = found[view][1, 1] = photo.focal_px
+            stated[view] = photo.focal_source or (
+                f"assumed: a phone's main camera, {PHONE_HFOV_DEG:g} degrees across")
+        if len(set(stated.values())) == 1:
+            return found, stated["front"]
+        return found, "; ".join(f"{view}: {source}" for view, source in stated.items())
     camera = load_camera(inputs.camera)
     found = {}
     for view, mask in masks.items():
@@ -119,16 +142,44 @@ def view_intrinsics(inputs: PersonInputs, masks: dict[str, np.ndarray]) -> dict[
             raise UserError(f"the {view} silhouette is {mask.shape[1]}x{mask.shape[0]} pixels but "
                             f"the upright photo of the camera is {size[1]}x{size[0]}")
         found[view] = k
-    return found
+    return found, f"calibrated: {inputs.camera}"
 
 
-def person_silhouettes(inputs: PersonInputs, projection: str
-                       ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray] | None]:
-    """(:func:`person_masks`, and :func:`view_intrinsics` for the ``"pinhole"`` projection,
-    else None): what a fit takes of the person's photos.
+@dataclasses.dataclass(frozen=True)
+class PersonPhotos:
+    """What a fit takes of the person's photos.
+
+    Attributes:
+        masks: view name -> (H, W) bool, the upright silhouettes; the side one as seen from
+            the person's left (mirrored when the photo shows the right).
+        intrinsics: view name -> (3, 3) K of those masks (None: orthographic views).
+        camera_source: where K came from (:func:`view_intrinsics`; "" orthographic).
+        side_from: which side of the person the side photo shows: "left", "right", or
+            "left (assumed)" when the feet do not tell.
+    """
+
+    masks: dict[str, np.ndarray]
+    intrinsics: dict[str, np.ndarray] | None
+    camera_source: str
+    side_from: str
+
+
+def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
+    """What a fit takes of the person's photos (:class:`PersonPhotos`): their masks
+    (:func:`person_masks`) and, for the ``"pinhole"`` projection, their cameras
+    (:func:`view_intrinsics`); a side photo from the person's right mirrored.
 
     Raises:
         UserError: as :func:`person_masks` and :func:`view_intrinsics`.
     """
     masks = person_masks(inputs)
-    return masks, view_intrinsics(inputs, masks) if projection == "pinhole" else None
+    intrinsics, source = (view_intrinsics(inputs, masks) if projection == "pinhole"
+                          else (None, ""))
+    seen = side_seen(masks["side"])
+    if seen == "right":
+        masks = masks | {"side": np.ascontiguousarray(masks["side"][:, ::-1])}
+        if intrinsics is not None:
+            mirrored = intrinsics["side"].copy()
+            mirrored[0, 2] = masks["side"].shape[1] - 1 - mirrored[0, 2]
+            intrinsics = intrinsics | {"side": mirrored}
+    return PersonPhotos(masks, intrinsics, source, seen or "left (assumed)")

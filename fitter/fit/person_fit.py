@@ -161,6 +161,9 @@ class Fit:
         view_bodies: view name -> (V, 3) float32 metres, the best candidate as the search
             scored it in that view (its pose with the view's fixed angles, e.g. the side
             view's arms down; not rescaled to the stature): what the view's canvas shows.
+        photos: what was read of the photos besides their masks (:func:`fit_inputs`):
+            ``camera`` (where K came from) and ``side_from`` (which side the side photo
+            shows); empty for a fit of masks.
     """
 
     search: SearchResult
@@ -172,6 +175,7 @@ class Fit:
     views: dict[str, kernels.ViewTarget]
     seconds: dict[str, float]
     view_bodies: dict[str, np.ndarray]
+    photos: dict[str, str] = dataclasses.field(default_factory=dict)
 
 
 def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
@@ -571,12 +575,15 @@ def fit_work(settings: FitSettings, result: SearchResult) -> str:
 def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = FitSettings(),
                progress: bool | None = None) -> Fit:
     """:func:`fit_person` of a person's inputs: their photos' silhouettes (or their own
-    masks) and, through a pinhole camera, the photos' intrinsics.
+    masks; a side photo from the right mirrored) and, through a pinhole camera, the
+    photos' intrinsics; ``Fit.photos`` says what was read.
 
     Raises:
         UserError: the inputs' problems
             (:func:`~bodyfit.fitter.fit.person.person_silhouettes`).
     """
-    masks, intrinsics = person_silhouettes(inputs, settings.projection)
-    return fit_person(model, masks, inputs.height_cm / 100.0, settings, progress, intrinsics,
-                      inputs.sex)
+    photos = person_silhouettes(inputs, settings.projection)
+    fit = fit_person(model, photos.masks, inputs.height_cm / 100.0, settings, progress,
+                     photos.intrinsics, inputs.sex)
+    return dataclasses.replace(fit, photos={"camera": photos.camera_source or "orthographic",
+                                            "side_from": photos.side_from})

