@@ -40,6 +40,7 @@ SETTINGS = {
     "bodyfit: the learned start alone": ["--iterations", "0"],
     "bodyfit: 5 iterations": ["--iterations", "5"],
     "bodyfit (default): 10 iterations": [],
+    "bodyfit: 10 iterations, the elbows at rest": ["--elbows", "rest"],
     "bodyfit: 40 iterations": ["--iterations", "40"],
     "bodyfit from the mean body: 40 iterations": ["--start", "mean", "--iterations", "40"],
     "thorough: one search 30 x 150": ["--method", "thorough", "--searches", "1",

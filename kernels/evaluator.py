@@ -263,6 +263,38 @@ class PopulationEvaluator:
                 done.result()
         return PopulationCost(costs, part_costs)
 
+    def evaluate_posed(self, posed: dict[str, np.ndarray]) -> PopulationCost:
+        """Costs and per-term costs of P candidates given as posed bodies: view name ->
+        (P, V, 3) float metres, each body as that view shows it (for poses the kernels'
+        rig cannot make, such as bent elbows); scored in one chunk by one worker.
+
+        Raises:
+            ValueError: a view missing, or bodies of another shape than (P, V, 3).
+        """
+        names = {data.view.name for views in self._pose_groups.values() for data in views}
+        if set(posed) != names:
+            raise ValueError(f"posed bodies are needed for the views {sorted(names)}, "
+                             f"got {sorted(posed)}")
+        shapes = {np.shape(bodies) for bodies in posed.values()}
+        count = next(iter(shapes))[0] if len(shapes) == 1 else 0
+        if len(shapes) != 1 or next(iter(shapes))[1:] != (self.model.num_vertices, 3):
+            raise ValueError(f"posed bodies must be (P, {self.model.num_vertices}, 3), "
+                             f"got {sorted(shapes)}")
+        if not self._workspaces or self._workspaces[0].capacity < count:
+            self._workspaces = [_Workspace(self.model, self._pose_groups, count)]
+        space = self._workspaces[0]
+        self._clock = self._timer()
+        term_costs, costs = space.term_costs[:count], space.costs[:count]
+        term_costs.zero_()
+        costs.zero_()
+        vertices = space.vertices[:count]
+        for views in space.pose_groups.values():
+            for buffers in views:
+                vertices.assign(wp.array(np.asarray(posed[buffers.data.view.name], np.float32),
+                                         dtype=wp.vec3, device=self.model.device))
+                self._evaluate_view(buffers, vertices, term_costs, costs)
+        return PopulationCost(costs.numpy().copy(), term_costs.numpy().copy())
+
     def _evaluate_chunk(self, space: _Workspace, betas: wp.array, pose_deg: wp.array):
         num = betas.shape[0]
         self._clock = self._timer()

@@ -42,6 +42,7 @@ class FitPhotos:
         intrinsics: view name -> (3, 3) K of the photos (None: orthographic views).
         views: view name -> the view its fit started on (its parts and pose are read).
         stature_m: the person's stature, metres.
+        flexion_deg: the elbows' flexion the fit answered with (None: the rest pose's).
     """
 
     settings: FitSettings
@@ -49,6 +50,7 @@ class FitPhotos:
     intrinsics: dict[str, np.ndarray] | None
     views: dict[str, kernels.ViewTarget]
     stature_m: float
+    flexion_deg: float | None
 
     @classmethod
     def of(cls, model: BodyModel, set_folder: Path, subject: str, record: dict) -> "FitPhotos":
@@ -70,16 +72,19 @@ class FitPhotos:
         views = person_views(model, masks, stature_m, settings, intrinsics,
                              extreme_bodies(model, s.components, s.pose_lower_deg,
                                             s.pose_upper_deg, settings.canvas.beta_limit))
-        return cls(settings, masks, intrinsics, views, stature_m)
+        return cls(settings, masks, intrinsics, views, stature_m,
+                   record["result"].get("elbow_deg"))
 
     def measure(self, model: BodyModel, measurer: Measurer, betas: np.ndarray,
                 pose_deg: np.ndarray
                 ) -> tuple[np.ndarray, dict[str, float], dict[str, ViewPhoto] | None]:
         """(rest (V, 3) metres, key -> mm, the view photos or None) of a body of the fit's
         search (betas (K,), the first solved to the stature when the search conditions it;
-        pose (4,) degrees), measured as `fitter run` measures its answer."""
+        pose (4,) degrees; the elbows as the fit answered), measured as `fitter run`
+        measures its answer."""
         _, rest, view_bodies = fitted_bodies(model, betas, pose_deg, self.views, self.stature_m,
-                                             self.settings.search.condition_stature)
+                                             self.settings.search.condition_stature,
+                                             self.flexion_deg)
         values = fitted_measurements(model, measurer, self.settings, rest, view_bodies,
                                      self.views, self.masks, self.intrinsics)
         return rest, values, view_photos(self.settings, self.views, view_bodies, self.masks,

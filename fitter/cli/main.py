@@ -116,9 +116,13 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="the local solver's iterations at most, after the searches "
                              "(default 10; 0: none; --method thorough and paper: 0)")
     parser.add_argument("--start", choices=("mean", "learned"),  # local_solver.SOLVER_STARTS
-                        help="where the local solver starts without a search: mean (the "
-                             "default: the mean body) or learned (the body a regression "
-                             "reads off the silhouettes; with --iterations 0, the answer)")
+                        help="where the local solver starts without a search: learned (the "
+                             "default: the body a regression reads off the silhouettes; with "
+                             "--iterations 0, the answer) or mean (the mean body)")
+    parser.add_argument("--elbows", choices=("fitted", "rest"),  # local_solver.ELBOWS
+                        help="the local solver's elbows: fitted (the default: one flexion "
+                             "for both arms and photos, solved with the body) or rest (the "
+                             "model's rest pose's, about 43 degrees)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
                              "first K components, --refinements of them, averaged (more "

@@ -50,8 +50,9 @@ import scipy.ndimage as ndi
 from scipy.spatial import cKDTree
 
 from bodyfit.common.errors import UserError
+from bodyfit.fitter.fit.elbows import elbow_forward, elbow_rig
 from bodyfit.fitter.fit.outline import OutlineSamples, ViewOutline, moved_camera
-from bodyfit.fitter.model.body_model import BodyModel, forward
+from bodyfit.fitter.model.body_model import BodyModel
 from bodyfit import kernels
 
 #: The blur (pixels) through which a silhouette's sub-pixel edge is read.
@@ -62,10 +63,16 @@ _EDGE_BAND_PX = 4.0
 _KNEE_FALL = 0.8
 #: Where the local solver starts (``SolverSettings.start``); the first is the default.
 SOLVER_STARTS = ("mean", "learned")
+#: How the solver treats the elbows: ``"fitted"``, one flexion for both arms and both
+#: photos solved with the body (:mod:`bodyfit.fitter.fit.elbows`); ``"rest"``, the rest
+#: pose's (the model's rig alone).
+ELBOWS = ("fitted", "rest")
+#: The bounds of a fitted elbow flexion, degrees.
+ELBOW_RANGE_DEG = (0.0, 60.0)
 #: How far (metres, each axis) the solver may move a view's camera from where it was placed.
 _CAMERA_REACH_M = 0.5
 
-__all__ = ["SOLVER_STARTS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
+__all__ = ["SOLVER_STARTS", "ELBOWS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
            "signed_distance", "sample_bilinear", "LocalProblem", "solve", "moved_view"]
 
 
@@ -91,6 +98,7 @@ class SolverSettings:
             (its angles 0), or ``"learned"``, the body and angles the learned start reads
             off the silhouettes (:mod:`bodyfit.fitter.fit.learned_start`; with 0
             iterations, that body is the answer).
+        elbows: one of ``ELBOWS``; a fitted flexion starts at the rest pose's.
     """
 
     iterations: int = 0
@@ -102,6 +110,7 @@ class SolverSettings:
     person_to_model: float = 0.5
     tolerance: float = 1e-5
     start: str = "mean"
+    elbows: str = "rest"
 
     def validate(self, stored_components: int) -> None:
         if self.iterations < 0:
@@ -118,6 +127,8 @@ class SolverSettings:
         if self.start not in SOLVER_STARTS:
             raise UserError(f"--start must be one of {', '.join(SOLVER_STARTS)}, "
                             f"got {self.start!r}")
+        if self.elbows not in ELBOWS:
+            raise UserError(f"--elbows must be one of {', '.join(ELBOWS)}, got {self.elbows!r}")
 
 
 def silhouette_edge(mask: np.ndarray) -> np.ndarray:
@@ -212,7 +223,8 @@ class Residuals:
 
 class LocalProblem:
     """One person's smooth cost (the module docstring) over the genes (betas 2..K, the
-    four angles) and a camera move per view.
+    four angles), the elbows' flexion when ``settings.elbows`` fits it, and a camera move
+    per view, in that order.
 
     Args:
         model: the render model (:func:`~bodyfit.fitter.fit.render_mesh.render_model`).
@@ -240,25 +252,38 @@ class LocalProblem:
         self.view_weights = {"front": cost.front_weight, "side": cost.side_weight}
         self.names = list(views)
         self.num_genes = self.k - 1 + 4
+        self.rig = elbow_rig(model) if settings.elbows == "fitted" else None
+        #: where the cameras' moves start in the parameters (after the elbows, if fitted)
+        self.camera_start = self.num_genes + (self.rig is not None)
+        elbow = [ELBOW_RANGE_DEG] if self.rig is not None else np.zeros((0, 2))
         self.lower = np.r_[np.full(self.k - 1, -beta_limit), pose_lower_deg,
-                           np.full(3 * len(views), -_CAMERA_REACH_M)]
+                           np.array(elbow)[:, 0], np.full(3 * len(views), -_CAMERA_REACH_M)]
         self.upper = np.r_[np.full(self.k - 1, beta_limit), pose_upper_deg,
-                           np.full(3 * len(views), _CAMERA_REACH_M)]
+                           np.array(elbow)[:, 1], np.full(3 * len(views), _CAMERA_REACH_M)]
+
+    def start(self, genes: np.ndarray) -> np.ndarray:
+        """The parameters of ``genes`` (K - 1 + 4,): the elbows at the rest pose's, the
+        cameras where they stand."""
+        elbow = [self.rig.rest_deg] if self.rig is not None else []
+        return np.clip(np.r_[genes, elbow, np.zeros(3 * len(self.names))], self.lower,
+                       self.upper)
 
     def camera_moves(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """View name -> (3,) metres, the move of its camera in the parameters ``x``."""
-        return {name: x[self.num_genes + 3 * i:self.num_genes + 3 * i + 3]
+        return {name: x[self.camera_start + 3 * i:self.camera_start + 3 * i + 3]
                 for i, name in enumerate(self.names)}
 
     def replace_view(self, view: kernels.ViewTarget) -> None:
         """Score against ``view`` (the view of its name with its camera placed anew)."""
         self.outlines[view.name].view = view
 
-    def body(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(betas (K,), pose (4,) degrees) of the parameters ``x``."""
+    def body(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float | None]:
+        """(betas (K,), pose (4,) degrees, the elbows' flexion in degrees or None for the
+        rest pose's) of the parameters ``x``."""
         genes = x[:self.num_genes]
         betas = self.conditioner.complete(genes[None, :self.k - 1], genes[None, self.k - 1:])[0]
-        return betas, genes[self.k - 1:]
+        return betas, genes[self.k - 1:], (float(x[self.num_genes]) if self.rig is not None
+                                            else None)
 
     def _first_beta_slope(self, x: np.ndarray) -> np.ndarray:
         """(K - 1,) d first beta / d betas 2..K (the stature held), by differences (the
@@ -273,13 +298,13 @@ class LocalProblem:
     def residuals(self, x: np.ndarray) -> "Residuals":
         """The residuals of the parameters ``x`` over every view's outline samples (one
         render a view), with what :meth:`jacobian` needs of them."""
-        betas, pose = self.body(x)
+        betas, pose, flexion = self.body(x)
         weights, distances, readings = [], [], []
         share = 1.0 - self.settings.person_to_model
         for name, move in self.camera_moves(x).items():
             outline = self.outlines[name]
             view = outline.view
-            posed = forward(self.model, betas[None], view.view_pose(pose[None]))[0]
+            posed = elbow_forward(self.model, betas[None], view.view_pose(pose[None]), flexion)[0]
             camera = moved_camera(view.camera, move)
             samples = outline.samples(posed.astype(np.float64), camera)
             mm, view_weight = view.millimetres_per_pixel, self.view_weights[name]
@@ -304,19 +329,21 @@ class LocalProblem:
     def jacobian(self, x: np.ndarray, residuals: "Residuals") -> np.ndarray:
         """(S, len(x)) d distances (mm) / d ``x`` of ``residuals`` (:meth:`residuals` of
         ``x``), rows in their order; no render."""
-        betas, pose = self.body(x)
+        betas, pose, flexion = self.body(x)
         slope = self._first_beta_slope(x)
         rows = []
         for i, (name, reading) in enumerate(zip(self.names, residuals.readings)):
             outline = self.outlines[name]
             mm = outline.view.millimetres_per_pixel
-            first = self.num_genes + 3 * i
-            d_pixels = outline.jacobian(reading.samples, betas, pose, reading.camera)
+            first = self.camera_start + 3 * i
+            d_pixels = outline.jacobian(reading.samples, betas, pose, reading.camera, flexion)
             d_points = np.zeros((len(reading.samples.points), 2, len(x)))
-            d_points[:, :, :self.num_genes] = np.concatenate(
+            # columns of d_pixels: K betas, 4 angles, the flexion if fitted, 3 camera
+            d_points[:, :, :self.camera_start] = np.concatenate(
                 [d_pixels[:, :, 1:self.k] + d_pixels[:, :, :1] * slope[None, None],
-                 d_pixels[:, :, self.k:self.k + 4]], axis=2)
-            d_points[:, :, first:first + 3] = d_pixels[:, :, self.k + 4:]
+                 d_pixels[:, :, self.k:self.k + self.camera_start - self.num_genes + 4]],
+                axis=2)
+            d_points[:, :, first:first + 3] = d_pixels[:, :, -3:]
             if reading.gradients is not None:
                 rows.append(mm * np.einsum("si,sik->sk", reading.gradients, d_points))
             if reading.nearest is not None:
@@ -340,14 +367,15 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
     Args:
         problem: the person's cost.
         start: the genes to start from.
-        place: None, or called with (betas (K,), pose (4,)) to place the cameras anew
-            (it calls ``problem.replace_view``), ``settings.placements`` times.
+        place: None, or called with :meth:`LocalProblem.body`'s (betas (K,), pose (4,),
+            flexion) to place the cameras anew (it calls ``problem.replace_view``),
+            ``settings.placements`` times.
 
     Returns:
-        (the solved parameters: genes, then each view's camera move, the trace).
+        (the solved parameters (:class:`LocalProblem`'s order), the trace).
     """
     s = problem.settings
-    x = np.clip(np.r_[start, np.zeros(3 * len(problem.names))], problem.lower, problem.upper)
+    x = problem.start(start)
     trace = SolverTrace()
     at = {round(s.iterations * (i + 1) / (s.placements + 1)) for i in range(s.placements)}
     damping = 1e-3
@@ -359,7 +387,7 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
     for iteration in range(s.iterations):
         if place is not None and iteration in at:
             place(*problem.body(x))
-            x[problem.num_genes:] = 0.0  # the cameras stand where the placement put them
+            x[problem.camera_start:] = 0.0  # the cameras stand where the placement put them
             residuals = problem.residuals(x)
             jacobian = problem.jacobian(x, residuals)
             trace.evaluations += 1

@@ -36,6 +36,7 @@ import warp as wp
 from scipy.spatial import cKDTree
 
 from bodyfit import kernels
+from bodyfit.fitter.fit.elbows import bend_derivative, bent, elbow_rig
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, rest_shape
 from bodyfit.kernels.body_forward import abduction_rotations, blend_skinning
 from bodyfit.kernels.body_layout import POSE_SIDES
@@ -143,7 +144,8 @@ def moved_camera(camera: kernels.ViewCamera, translation_m: np.ndarray) -> kerne
 
 
 def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
-                        vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                        vertices: np.ndarray, flexion_deg: float | None = None
+                        ) -> tuple[np.ndarray, np.ndarray]:
     """Posed vertices of one body and their derivatives, float64.
 
     Args:
@@ -151,24 +153,34 @@ def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarra
         betas: (K,) shape coefficients, standard deviations.
         pose_deg: (4,) the pose the body is posed in, degrees, ``POSE_NAMES`` order.
         vertices: (N,) int, the vertices wanted.
+        flexion_deg: both elbows bent to this before the skinning
+            (:mod:`bodyfit.fitter.fit.elbows`), or None (the rest pose's).
 
     Returns:
         posed: (N, 3) metres.
-        jacobian: (N, 3, K + 4): d posed / d (betas, then the four angles), metres per
-            standard deviation and metres per degree. For a fixed pose the posed vertices
-            are linear in the betas (the skinning applied to the shape directions); each
-            chain's angle turns its share of the vertex about its joint.
+        jacobian: (N, 3, K + 4 (+ 1)): d posed / d (betas, then the four angles, then
+            the flexion when given), metres per standard deviation and per degree. For a
+            fixed pose the posed vertices are linear in the betas (the skinning applied to
+            the shape directions); each chain's angle turns its share of the vertex about
+            its joint; the flexion turns the forearms before.
     """
     k = len(betas)
     rest, joints = rest_shape(model, np.asarray(betas)[None])
-    rest = rest[0, vertices].astype(np.float64)
     joints = joints[0].astype(np.float64)
     vertex_dirs, joint_dirs = model.shape_directions(k)
+    if flexion_deg is None:
+        rest = rest[0, vertices].astype(np.float64)
+        dirs = vertex_dirs[:, vertices].astype(np.float64)
+    else:
+        rig = elbow_rig(model)
+        d_flexion = bend_derivative(rig, rest[0], flexion_deg)[vertices]
+        rest = bent(rig, rest[0], flexion_deg)[vertices]
+        dirs = bent(rig, vertex_dirs, flexion_deg)[:, vertices]
+    dirs = dirs.transpose(1, 2, 0)  # (N, 3, K)
     rotations = abduction_rotations(np.asarray(pose_deg, np.float64)[None])[0]  # (4, 3, 3)
     weights = model.chain_weights[vertices].astype(np.float64)  # (N, 4)
     posed = blend_skinning(weights, rest[None], joints[None], rotations[None])[0]
     # d posed / d beta_k: the skinning of the shape direction (vertex and joint parts)
-    dirs = vertex_dirs[:, vertices].astype(np.float64).transpose(1, 2, 0)  # (N, 3, K)
     jdirs = joint_dirs.astype(np.float64).transpose(1, 2, 0)  # (4, 3, K)
     d_betas = dirs * (1.0 - weights.sum(axis=1))[:, None, None]
     for c in range(len(POSE_NAMES)):
@@ -182,7 +194,13 @@ def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarra
         d_rot = np.array([[-sin, 0, -cos], [0, 0, 0], [cos, 0, -sin]]) \
             * POSE_SIDES[c] * np.pi / 180.0
         d_angles[:, :, c] = weights[:, c, None] * ((rest - joints[c]) @ d_rot.T)
-    return posed.astype(np.float64), np.concatenate([d_betas, d_angles], axis=2)
+    columns = [d_betas, d_angles]
+    if flexion_deg is not None:  # the skinning is linear in the rest body, joints held
+        skinned = d_flexion * (1.0 - weights.sum(axis=1))[:, None]
+        for c in range(len(POSE_NAMES)):
+            skinned += weights[:, c, None] * (d_flexion @ rotations[c].T)
+        columns.append(skinned[:, :, None])
+    return posed.astype(np.float64), np.concatenate(columns, axis=2)
 
 
 def _on_envelope(points: np.ndarray, normals: np.ndarray) -> np.ndarray:
@@ -277,14 +295,16 @@ class ViewOutline:
         return row, col
 
     def jacobian(self, samples: OutlineSamples, betas: np.ndarray, pose_deg: np.ndarray,
-                 camera: kernels.ViewCamera) -> np.ndarray:
-        """(S, 2, K + 4 + 3) d sample pixels / d (betas, the four angles, the camera's
-        translation) of a body (betas (K,), its own pose (4,) degrees) seen by ``camera``:
-        the view's fixed angles (the side view's arms) do not move with the body's, so
-        their columns are zero."""
+                 camera: kernels.ViewCamera, flexion_deg: float | None = None) -> np.ndarray:
+        """(S, 2, K + 4 (+ 1) + 3) d sample pixels / d (betas, the four angles, the
+        elbows' flexion when given, the camera's translation) of a body (betas (K,), its
+        own pose (4,) degrees, its elbows' flexion or None) seen by ``camera``: the view's
+        fixed angles (the side view's arms) do not move with the body's, so their columns
+        are zero."""
         view_pose = self.view.view_pose(np.asarray(pose_deg, np.float64)[None])[0]
         wanted, index = np.unique(samples.edges.ravel(), return_inverse=True)
-        posed, d_posed = posed_with_jacobian(self.model, betas, view_pose, wanted)
+        posed, d_posed = posed_with_jacobian(self.model, betas, view_pose, wanted,
+                                             flexion_deg)
         _, d_camera = project_with_jacobian(camera, posed)
         rotation = camera_matrices(camera)[1]
         d = np.concatenate([np.einsum("nij,njk->nik", d_camera @ rotation, d_posed), d_camera],

@@ -17,6 +17,7 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
                                        orthographic_view)
+from bodyfit.fitter.fit.elbows import elbow_forward
 from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
@@ -75,7 +76,7 @@ class FitSettings:
     """
 
     search: SearchSettings = SearchSettings(searches=0, refine_components=0)
-    solver: SolverSettings = SolverSettings(iterations=10, start="learned")
+    solver: SolverSettings = SolverSettings(iterations=10, start="learned", elbows="fitted")
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="model_to_person",
@@ -242,10 +243,11 @@ def _scoring(model: BodyModel, views: dict[str, kernels.ViewTarget], settings: F
 
 def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                    view: kernels.ViewTarget, stature_m: float,
-                   condition_stature: bool) -> np.ndarray:
+                   condition_stature: bool, flexion_deg: float | None = None) -> np.ndarray:
     """(V', 3) float64 metres: the body a pinhole view's camera is placed from
     (:func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
-    (4,) degrees): the parts the view shows, in the view's pose, as the kernels render it.
+    (4,) degrees, its elbows' flexion or None for the rest pose's): the parts the view
+    shows, in the view's pose, as the kernels (or the local solver) render it.
 
     A candidate conditioned on the stature (:mod:`bodyfit.fitter.fit.stature`) is taken as it
     is: on the rest stature (pinhole views) it is the person's size. (Conditioned on the
@@ -257,7 +259,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     conditioning a candidate has its own height, and the camera is placed for it scaled to
     the person's stature.
     """
-    body = forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
+    body = elbow_forward(model, betas[None], view.view_pose(pose_deg[None]), flexion_deg)[0]
     if not condition_stature:
         body = body * stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
     shown = visible_vertices(model.vertex_parts, view.visible_parts)
@@ -265,14 +267,15 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
 
 
 def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
-                  betas: np.ndarray, pose_deg: np.ndarray) -> None:
+                  betas: np.ndarray, pose_deg: np.ndarray,
+                  flexion_deg: float | None = None) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
-    degrees) as the kernels render it (:func:`placement_body`,
+    degrees, elbows' flexion or None) as it is rendered (:func:`placement_body`,
     :func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`); updates ``views`` and the
     evaluator."""
     for name, view in views.items():
         body = placement_body(model, betas, pose_deg, view, stature_m,
-                              settings.search.condition_stature)
+                              settings.search.condition_stature, flexion_deg)
         views[name] = placed_anew(view, masks[name], intrinsics[name], body)
         evaluator.replace_view(views[name])
 
@@ -426,21 +429,26 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         start = np.clip(learned_genes(model, masks, stature_m, sex, solver.components),
                         problem.lower[:problem.num_genes], problem.upper[:problem.num_genes])
 
-    def place(betas: np.ndarray, pose_deg: np.ndarray) -> None:
+    def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None) -> None:
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
-                      pose_deg)
+                      pose_deg, flexion_deg)
         for view in views.values():
             problem.replace_view(view)
 
     pinhole = settings.projection == "pinhole"
     if settings.learned_start and pinhole:  # the cameras placed for the start's body
-        place(*problem.body(start))
+        place(*problem.body(problem.start(start)))
     solved, trace = solve(problem, start, place if pinhole else None)
-    betas, pose = problem.body(solved)
+    betas, pose, flexion = problem.body(solved)
     for name, move in problem.camera_moves(solved).items():
         views[name] = moved_view(views[name], move)
         evaluator.replace_view(views[name])
-    scored = evaluator.evaluate(betas[None], pose[None])
+    if flexion is None:
+        scored = evaluator.evaluate(betas[None], pose[None])
+    else:  # the kernels' rig has no elbows: the bodies as the solver posed them
+        scored = evaluator.evaluate_posed({
+            name: elbow_forward(problem.model, betas[None], view.view_pose(pose[None]), flexion)
+            for name, view in views.items()})
     genes = np.array(trace.genes) if trace.genes else start[None]
     # the solver's cost per iteration; with none (the learned start alone), the start's
     costs = np.array(trace.costs or [problem.cost(problem.residuals(solved), solved,
@@ -453,19 +461,23 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         best_betas=per_iteration,
         final_genes=np.r_[betas, pose][None], final_costs=scored.costs[:1].astype(np.float64),
         evaluations=trace.evaluations, generations=len(trace.costs),
-        seconds=time.perf_counter() - began, stop_reasons={"solver": trace.stop_reason})
+        seconds=time.perf_counter() - began, stop_reasons={"solver": trace.stop_reason},
+        elbow_deg=flexion)
     return result if first is None else refined(first, result)
 
 
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                   views: dict[str, kernels.ViewTarget], stature_m: float,
-                  condition_stature: bool) -> tuple[np.ndarray, np.ndarray, dict]:
-    """The fit's bodies of its answer (betas (K,), pose (4,) degrees), float32 metres:
+                  condition_stature: bool, flexion_deg: float | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The fit's bodies of its answer (betas (K,), pose (4,) degrees, elbows' flexion or
+    None for the rest pose's; the rest body keeps the rest pose's), float32 metres:
     (posed (V, 3), rest (V, 3), view name -> (V, 3) in that view's pose), the posed and
     rest bodies rescaled to the stature when the search conditioned it (a posed height
     conditioned, or a first beta at its limit), the view bodies as the search scored them."""
-    posed = forward(model, betas[None], pose_deg[None])[0]
-    view_bodies = {name: forward(model, betas[None], view.view_pose(pose_deg[None]))[0]
+    posed = elbow_forward(model, betas[None], pose_deg[None], flexion_deg)[0]
+    view_bodies = {name: elbow_forward(model, betas[None], view.view_pose(pose_deg[None]),
+                                       flexion_deg)[0]
                    for name, view in views.items()}
     rest = rest_shape(model, betas[None])[0][0]
     if condition_stature:
@@ -543,7 +555,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                          bodies)
     t2 = time.perf_counter()
     posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
-                                             stature_m, s.condition_stature)
+                                             stature_m, s.condition_stature,
+                                             result.elbow_deg)
     measurer = Measurer.from_model(model)
     measurements = fitted_measurements(model, measurer, settings, rest, view_bodies, views,
                                        masks, intrinsics)

@@ -11,7 +11,8 @@ within ``_EXTREME_BAND_M`` of the body's top and bottom (a candidate's rendered 
 the height the stature conditioning solved for).
 
 The model it returns is a :class:`~bodyfit.fitter.model.body_model.BodyModel` over the kept
-vertices (no landmarks): the kernels render and score it; the fitted body, its
+vertices (with the landmarks whose vertices are all kept, such as the limbs' rings): the
+kernels render and score it, the local solver bends its elbows by its rings; the fitted body, its
 measurements and the pictures use the full model. At 8 mm: 19,900 triangles, 9,874
 vertices; the kernels' speed: docs/fitter.md, "Speed".
 
@@ -79,9 +80,12 @@ def render_model(model: BodyModel, cell_mm: float) -> BodyModel:
     faces = faces[whole]
     once = np.sort(np.unique(np.sort(faces, axis=1), axis=0, return_index=True)[1])
     kept, faces = np.unique(faces[once], return_inverse=True)
+    index = np.full(len(rest), -1)
+    index[kept] = np.arange(len(kept))
     return dataclasses.replace(
         model, mean_vertices=model.mean_vertices[kept],
         vertex_components=model.vertex_components[:, kept],
         faces=faces.reshape(-1, 3).astype(model.faces.dtype),
         vertex_parts=model.vertex_parts[kept], chain_weights=model.chain_weights[kept],
-        landmarks={})
+        landmarks={name: index[vertices] for name, vertices in model.landmarks.items()
+                   if np.all(index[vertices] >= 0)})

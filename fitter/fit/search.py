@@ -171,6 +171,8 @@ class SearchResult:
         stop_reasons: the optimiser's reasons for stopping.
         averaged_from: the results whose answers were averaged into this one
             (:func:`averaged`; after :func:`refined`, the refinements'); () for one search.
+        elbow_deg: the elbows' flexion of the answer, degrees (the local solver's
+            ``elbows="fitted"``); None: the rest pose's.
     """
 
     betas: np.ndarray
@@ -187,6 +189,7 @@ class SearchResult:
     seconds: float
     stop_reasons: dict
     averaged_from: tuple["SearchResult", ...] = ()
+    elbow_deg: float | None = None
 
 
 class _Search:

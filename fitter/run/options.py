@@ -52,7 +52,7 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     (``matching``, ``vertical_anchor``, ``weights`` (a preset or a .toml file, replacing
     the weights) and ``weight`` (a list of ``NAME=VALUE`` overrides on top)), ``device``,
     ``threads``, ``side_arms``, ``projection``, ``placement_rounds`` and the local solver's
-    ``iterations`` and ``start``.
+    ``iterations``, ``start`` and ``elbows``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -73,7 +73,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     elif "weight" in given:  # on top of the method's or the recorded weights
         record = weights_record(cost) | dict(map(parse_override, given["weight"]))
         cost = settings_from_record(record, cost)
-    solver = dataclasses.replace(base.solver, **{k: given[k] for k in ("iterations", "start")
+    solver = dataclasses.replace(base.solver, **{k: given[k] for k in
+                                                 ("iterations", "start", "elbows")
                                                  if k in given})
     return dataclasses.replace(base, search=search, solver=solver, cost=cost,
                                device=given.get("device", base.device),

@@ -86,6 +86,7 @@ def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fi
             "part_costs": dict(zip(kernels.TERM_NAMES, map(float, result.part_costs))),
             "betas": result.betas.tolist(),
             "pose_deg": dict(zip(POSE_NAMES, result.pose_deg.tolist())),
+            "elbow_deg": result.elbow_deg,
             "evaluations": result.evaluations,
             "generations": result.generations,
             "stop_reasons": {k: str(v) for k, v in result.stop_reasons.items()},

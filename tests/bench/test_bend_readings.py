@@ -29,7 +29,7 @@ def test_a_swing_turns_the_bicep_about_its_arm_and_a_tilt_does_not(body_model, m
     camera changes it by under a tenth of that."""
     rest, joints = mean_rest
     bodies = Bodies(np.array(["female"]), np.array([False]), rest[None], joints[None],
-                    POSE_DEG[None], np.zeros((1, 4)))
+                    POSE_DEG[None], np.zeros((1, 4)), np.zeros((1, 0)), {})
     swing, tilt = bend_readings.twist_width_change(body_model, measurer, bodies, 0)
     body = bent_bodies(body_model, rest, joints, POSE_DEG[None], np.zeros(4)[None])[0]
     section = measurer.girth_section(body, "H.L")

@@ -12,9 +12,11 @@ from bodyfit.fitter.model_build.anny_source import PHENOTYPES, SHAPE_PARAMETERS
 
 @pytest.fixture(scope="module")
 def body(anny_source):
-    """(skeleton, rest (V, 3), every bone's head (B, 3), name -> head) of one Anny woman."""
-    params = np.array([[0.5 if name in PHENOTYPES else 0.0 for name in SHAPE_PARAMETERS]])
-    rest, heads = anny_source.rest_bodies(np.array([1.0]), params, all_bones=True)
+    """(skeleton, rest (V, 3), every bone's head (B, 3), name -> head) of one Anny man
+    (phenotypes at the middle of their ranges but a younger age, no local change)."""
+    params = np.array([[{"age": 0.35}.get(name, 0.5) if name in PHENOTYPES else 0.0
+                        for name in SHAPE_PARAMETERS]])
+    rest, heads = anny_source.rest_bodies(np.array([0.0]), params, all_bones=True)
     skeleton = anny_source.skeleton()
     rest, heads = rest[0].astype(float), heads[0].astype(float)
     return skeleton, rest, heads, dict(zip(skeleton.labels, heads))
@@ -66,3 +68,49 @@ def test_side_photo_from_the_right_is_the_body_turned_round(body):
     np.testing.assert_array_equal(left[0], right[0])
     half_turn = Rotation.from_euler("z", 180, degrees=True).as_matrix()
     np.testing.assert_allclose(right[1], left[1] @ half_turn.T, atol=1e-6)
+
+
+def test_straight_hanging_arms_are_fitted_with_their_length(body, body_model, measurer,
+                                                             tmp_path):
+    """A body standing with straight arms (elbows 5 degrees) photographed by the
+    benchmark's renderer. Fitted with the elbows fitted: the flexion within 10 degrees,
+    the arm length within 25 mm (today's tolerance, not ISO's 5), the 7 important within
+    15 mm on average and under half of what the rest pose's elbows give (about 43
+    degrees: the side view's hands in front of the belly; measured 12 against 35 mm)."""
+    import dataclasses
+
+    from bench.accuracy.photos import PhotoEffects, Shot, write_photos
+    from bodyfit.calib.camera import Camera, camera_fields
+    from bodyfit.fitter.demo.example import demo_camera
+    from bodyfit.fitter.fit.person import PersonInputs
+    from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
+    from bodyfit.fitter.measure.measurements import IMPORTANT
+    from bodyfit.fitter.output.result_files import write_json
+
+    skeleton, rest, heads, _ = body
+    stance = {name: value[0] for name, value in
+              draw_stances(StanceSettings(), 1, np.random.default_rng(5)).items()}
+    stance |= {"front_arm_deg": np.full(2, 35.0), "front_elbow_deg": np.full(2, 5.0),
+               "front_twist_deg": np.full(2, 20.0), "side_out_deg": np.full(2, 5.0),
+               "side_swing_deg": np.zeros(2), "side_elbow_deg": np.full(2, 5.0),
+               "side_from_right": 0.0}
+    front, side = posed_bodies(skeleton, rest, heads, stance)
+    lens = demo_camera((900, 1200))
+    camera = Camera(lens.image_size_px, lens.K, np.zeros(5))
+    shot = Shot(3.0, 1.1)
+    write_photos(tmp_path, body_model, {"front": front, "side": side}, camera,
+                 {"front": shot, "side": shot}, PhotoEffects(), np.random.default_rng(0))
+    write_json(tmp_path / "camera.json", camera_fields(camera))
+    truth = measurer.measure(rest)
+    inputs = PersonInputs(str(tmp_path / "front.jpg"), str(tmp_path / "side.jpg"),
+                          truth["O"] / 10, str(tmp_path / "camera.json"))
+    settings = FitSettings()
+    fits = {elbows: fit_inputs(body_model, inputs, dataclasses.replace(
+        settings, solver=dataclasses.replace(settings.solver, elbows=elbows)), progress=False)
+        for elbows in ("fitted", "rest")}
+    important = {name: np.mean([abs(fit.measurements[k] - truth[k]) for k in IMPORTANT])
+                 for name, fit in fits.items()}
+    assert fits["fitted"].search.elbow_deg == pytest.approx(5.0, abs=10.0)
+    assert fits["rest"].search.elbow_deg is None
+    assert abs(fits["fitted"].measurements["J"] - truth["J"]) < 25.0
+    assert important["fitted"] < 15.0 and important["fitted"] < important["rest"] / 2

@@ -102,10 +102,15 @@ def test_outline_jacobian_matches_finite_differences(body_model, subject, name):
         assert not jacobian[:, :, 20:22].any()
 
 
-def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, subject):
+@pytest.mark.parametrize("flexion", [None, 8.0])
+def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, subject,
+                                                         flexion):
     """The analytic case: the silhouettes are a body's own renders through the views'
-    cameras, the body one of the solver's candidates (10 components); from the mean body,
-    the solver finds its shape and pose again."""
+    cameras, the body one of the solver's candidates (10 components; its elbows the rest
+    pose's, or bent to 8 degrees and fitted); from the mean body, the solver finds its
+    shape and pose (and flexion) again."""
+    from bodyfit.fitter.fit.elbows import elbow_forward
+
     folder, truth = subject
     model = render_model(body_model, 8.0)
     k = 10
@@ -118,25 +123,33 @@ def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, s
         mean = forward(model, np.zeros((1, k)), np.zeros((1, 4)))[0]
         placed = pinhole_view(name, person_mask(folder / f"{name}.png"), K_TRUE, stature,
                               extent.reshape(-1, 3), mean, model.vertex_parts, **options)
-        body = forward(model, betas[None], placed.view_pose(POSE[None]))[0]
+        body = elbow_forward(model, betas[None], placed.view_pose(POSE[None]), flexion)[0]
         faces, parts = visible_faces(model.faces, model.face_parts, placed.visible_parts)
         own = rasterize(body[None], faces, parts, placed.camera, placed.height,
                         placed.width).numpy()[0] >= 0
         views[name] = prepare_view_target(name, own, placed.camera,
                                           placed.millimetres_per_pixel, **options)
     conditioner = StatureConditioner(body_model, k, stature, 3.0, extent)
-    settings = SolverSettings(iterations=40, components=k, placements=0)
+    settings = SolverSettings(iterations=40, components=k, placements=0,
+                              elbows="rest" if flexion is None else "fitted")
     problem = LocalProblem(model, views, cost_settings("bodyfit"), conditioner, k,
                            (-10.0,) * 4, (30.0,) * 4, 3.0, settings)
     solved, trace = solve(problem, np.zeros(problem.num_genes))
-    found_betas, found_pose = problem.body(solved)
-    np.testing.assert_allclose(found_pose, POSE, atol=0.3)
-    np.testing.assert_allclose(found_betas, betas, atol=0.15)
+    found_betas, found_pose, found_flexion = problem.body(solved)
+    if flexion is None:
+        assert found_flexion is None
+        np.testing.assert_allclose(found_pose, POSE, atol=0.3)
+    else:  # from the rest pose's 43 degrees; the front view trades the elbows against the
+        # shoulders (measured: 11.6 degrees, the shoulders 1.2 and 2.2 degrees low)
+        assert found_flexion == pytest.approx(flexion, abs=5.0)
+        np.testing.assert_allclose(found_pose, POSE, atol=3.0)
     found, true = (measurer.measure(rest_shape(body_model, b[None])[0][0])
                    for b in (found_betas, betas))
     errors = {key: found[key] - true[key] for key in "BCDEFLP"}
-    assert max(map(abs, errors.values())) < 1.0, errors
-    assert np.abs(solved[problem.num_genes:]).max() < 0.01  # the cameras stay, metres
+    if flexion is None:
+        np.testing.assert_allclose(found_betas, betas, atol=0.15)
+    assert max(map(abs, errors.values())) < (1.0 if flexion is None else 1.5), errors
+    assert np.abs(solved[problem.camera_start:]).max() < 0.01  # the cameras stay, metres
 
 
 def test_settings_the_solver_cannot_fit_with_are_one_line_errors():
@@ -152,3 +165,34 @@ def test_settings_the_solver_cannot_fit_with_are_one_line_errors():
         dataclasses.replace(default, search=dataclasses.replace(
             default.search, refine_components=50)).validate(60)
     METHODS["thorough"].validate(60)  # the population search alone
+
+
+
+def test_outline_jacobian_with_bent_elbows(body_model, subject):
+    """The flexion's column, against finite differences of the projected samples."""
+    from bodyfit.fitter.fit.elbows import elbow_forward
+
+    folder, truth = subject
+    model = render_model(body_model, 8.0)
+    mean = forward(model, np.zeros((1, 20)), np.zeros((1, 4)))[0]
+    extent = extreme_bodies(model, 20, [-10.0] * 4, [30.0] * 4).reshape(-1, 3)
+    view = pinhole_view("side", person_mask(folder / "side.png"), K_TRUE, truth["O"] / 1000,
+                        extent, mean, model.vertex_parts,
+                        **side_view_options(body_model, "down"))
+    outline = ViewOutline(model, view)
+    betas, pose, flexion = np.random.default_rng(2).normal(0.0, 0.7, 20), np.zeros(4), 15.0
+    camera = moved_camera(view.camera, np.array([0.01, -0.02, 0.05]))
+    posed = elbow_forward(model, betas[None], view.view_pose(pose[None]), flexion)[0]
+    samples = outline.samples(posed.astype(np.float64), camera)
+    jacobian = outline.jacobian(samples, betas, pose, camera, flexion)
+    assert jacobian.shape[2] == 20 + 4 + 1 + 3
+
+    def points(f):
+        body = elbow_forward(model, betas[None], view.view_pose(pose[None]), f)[0]
+        ends, _ = project_with_jacobian(camera, body.astype(np.float64)[samples.edges.ravel()])
+        return ends.reshape(-1, 2, 2).mean(axis=1)
+
+    numeric = (points(flexion + 0.05) - points(flexion - 0.05)) / 0.1
+    scale = np.abs(jacobian[:, :, 24]).max()
+    assert scale > 0.5  # pixels per degree: the forearms' outline moves
+    assert np.abs(numeric - jacobian[:, :, 24]).max() < 0.01 * scale + 2e-3

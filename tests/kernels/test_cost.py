@@ -222,3 +222,25 @@ def test_evaluator_rejects_bad_views_and_populations(model_arrays, views):
         PopulationEvaluator(model_arrays, [views[0], views[0]])
     with pytest.raises(ValueError, match=r"pose_deg must have shape \(P=2, 4\)"):
         PopulationEvaluator(model_arrays, views).evaluate(np.zeros((2, 20)), np.zeros((3, 4)))
+
+
+def test_posed_bodies_cost_what_their_parameters_cost(body_model, model_arrays, views,
+                                                      candidates):
+    """evaluate_posed of the bodies the NumPy forward poses from the candidates (each as
+    its view renders it) gives evaluate's costs; a view missing or a wrong shape is
+    refused."""
+    from bodyfit.kernels.body_forward import forward
+
+    betas, pose = candidates
+    evaluator = PopulationEvaluator(model_arrays, views)
+    by_parameters = evaluator.evaluate(betas, pose)
+    k = model_arrays.num_components
+    posed = {view.name: forward(body_model, betas[:, :k], view.view_pose(pose)) for view in views}
+    by_bodies = evaluator.evaluate_posed(posed)
+    np.testing.assert_allclose(by_bodies.costs, by_parameters.costs, rtol=1e-5, atol=1e-3)
+    np.testing.assert_allclose(by_bodies.part_costs, by_parameters.part_costs, rtol=1e-5,
+                               atol=1e-3)
+    with pytest.raises(ValueError, match="views"):
+        evaluator.evaluate_posed({"front": posed["front"]})
+    with pytest.raises(ValueError, match="must be"):
+        evaluator.evaluate_posed({name: bodies[:, :10] for name, bodies in posed.items()})
