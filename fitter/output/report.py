@@ -83,9 +83,12 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
     result = record["result"]
     default = "the optimiser's default"
     learned = solver.get("start") == "learned"
+    elbows = result.get("elbow_deg")
     solver_row = ("local solver", f"{_e(solver['iterations'])} iterations at most, "
                                   f"{_e(solver['components'])} components"
                                   + (", from the learned start" if learned else "")
+                                  + ("" if elbows is None else
+                                     f"; the elbows fitted, {elbows:.1f} degrees")
                   if solver["iterations"] else
                   "none: the learned start's body" if learned else "none")
     if not search["searches"]:
@@ -132,9 +135,10 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
              if value is not None and name not in ("height_cm", "sex")]
     given += [("stature", f"{inputs['height_cm']:g} cm"), ("sex", _e(inputs["sex"]))]
     photos = record.get("photos", {})
-    given += [(label, _e(photos[key])) for key, label in
-              (("camera", "camera used"), ("side_from", "side photo shows the person's"))
-              if key in photos]
+    if "camera" in photos:
+        given.append(("camera used", _e(photos["camera"])))
+    if "side_from" in photos:
+        given.append(("side photo", f"the person's {_e(photos['side_from'])} side"))
     terms = [("total", f"{result['best_cost']:.2f}")]
     terms += [(name, f"{value:.2f}") for name, value in result["part_costs"].items()]
     timings = [(stage, f"{seconds:.2f} s") for stage, seconds in record["timings_s"].items()]

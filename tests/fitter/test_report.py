@@ -97,6 +97,9 @@ def test_report_is_one_self_contained_escaped_page(first_run):
         assert float(row[2]) == pytest.approx(values[name]["spread_mm"], abs=0.051)
     assert '<th>waist</th><td class="num">7</td>' in text
     assert "<th>optimizer</th><td>ga</td>" in text and "<th>seed</th><td>5</td>" in text
+    photos = json.loads((first_run / "run.json").read_text())["photos"]
+    assert f"<th>camera used</th><td>{html.escape(photos['camera'])}</td>" in text
+    assert f"<th>side photo</th><td>the person's {photos['side_from']} side</td>" in text
 
 
 def test_run_json_round_trips_into_the_same_settings(first_run):
