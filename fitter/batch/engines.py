@@ -201,15 +201,22 @@ class LocalEngine:
         worker died; the jobs to try again are back at the queue's head)."""
         in_flight = {}
         while queue or in_flight:
+            broken = False
             while queue and len(in_flight) < self.workers:
                 alone = deaths.suspect(queue[0].subject_id)
                 if in_flight and (alone or any(deaths.suspect(job.subject_id)
                                                for job in in_flight.values())):
                     break  # a suspect runs alone
                 job = queue.popleft()
-                in_flight[pool.submit(_run_local_job, job)] = job
+                try:
+                    in_flight[pool.submit(_run_local_job, job)] = job
+                except BrokenProcessPool:  # a worker died since the last wait: the job
+                    queue.appendleft(job)  # waits, the futures in flight say who died
+                    broken = True
+                    break
             done, _ = wait(in_flight, return_when=FIRST_COMPLETED)
-            if any(isinstance(future.exception(), BrokenProcessPool) for future in done):
+            if broken or any(isinstance(future.exception(), BrokenProcessPool)
+                             for future in done):
                 wait(in_flight)  # a broken pool fails every future in flight at once
                 again = []
                 for future, job in in_flight.items():
