@@ -119,6 +119,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="where the local solver starts without a search: learned (the "
                              "default: the body a regression reads off the silhouettes; with "
                              "--iterations 0, the answer) or mean (the mean body)")
+    parser.add_argument("--arms-lower-deg", type=float, metavar="DEG",
+                        help="the arms' lowest abduction from the rest A-pose (default -25: "
+                             "17 degrees from hanging; -10: the default before, and "
+                             "--method thorough's and paper's)")
     parser.add_argument("--elbows", choices=("fitted", "rest"),  # local_solver.ELBOWS
                         help="the local solver's elbows: fitted (the default: one flexion "
                              "for both arms and photos, solved with the body) or rest (the "

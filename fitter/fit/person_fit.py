@@ -40,6 +40,12 @@ __all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fit_wor
            "person_views", "place_cameras", "placement_body", "refinement_scoring",
            "stature_conditioner", "view_photos"]
 
+#: The default's lowest abduction angles, degrees (``POSE_NAMES`` order): the arms down to
+#: 17 degrees from hanging (the rest pose's are 43 out), as people hold them in a front
+#: photo; the searches' range (thorough, paper) stays -10.
+ARMS_LOWER_DEG = (-25.0, -25.0, -10.0, -10.0)
+
+
 @dataclasses.dataclass(frozen=True)
 class FitSettings:
     """Everything about a fit but the person.
@@ -75,7 +81,8 @@ class FitSettings:
             measurement is the fitted mesh's.
     """
 
-    search: SearchSettings = SearchSettings(searches=0, refine_components=0)
+    search: SearchSettings = SearchSettings(searches=0, refine_components=0,
+                                            pose_lower_deg=ARMS_LOWER_DEG)
     solver: SolverSettings = SolverSettings(iterations=10, start="learned", elbows="fitted")
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(

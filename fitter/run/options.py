@@ -51,7 +51,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     ``refine_components``, that not given, turns the refinement off), the cost's
     (``matching``, ``vertical_anchor``, ``weights`` (a preset or a .toml file, replacing
     the weights) and ``weight`` (a list of ``NAME=VALUE`` overrides on top)), ``device``,
-    ``threads``, ``side_arms``, ``projection``, ``placement_rounds`` and the local solver's
+    ``threads``, ``side_arms``, ``projection``, ``placement_rounds``, ``arms_lower_deg``
+    (both shoulders' lowest abduction) and the local solver's
     ``iterations``, ``start`` and ``elbows``.
 
     Raises:
@@ -66,6 +67,9 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
                                                  if k in given})
     if given.get("free_stature"):
         search = dataclasses.replace(search, condition_stature=False)
+    if "arms_lower_deg" in given:
+        search = dataclasses.replace(search, pose_lower_deg=(
+            (float(given["arms_lower_deg"]),) * 2 + tuple(search.pose_lower_deg[2:])))
     cost = dataclasses.replace(base.cost, **{k: given[k] for k in ("matching", "vertical_anchor")
                                              if k in given})
     if "weights" in given:

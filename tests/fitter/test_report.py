@@ -240,3 +240,16 @@ def test_the_default_method_reports_the_calibrated_spread(first_run, tmp_path, c
         assert written["measurements"][name]["spread_mm"] == pytest.approx(
             factors[key] * cost, abs=0.006)
     assert SPREAD_NOTES["calibrated"] in html.unescape((out / "report.html").read_text())
+
+
+def test_the_arms_lower_bound_is_the_defaults_and_replaced_by_name():
+    """bodyfit's arms reach -25 degrees, the searches' -10; --arms-lower-deg sets both
+    shoulders and leaves the hips."""
+    from bodyfit.fitter.fit.person_fit import METHODS
+    from bodyfit.fitter.run.options import fit_settings
+
+    assert METHODS["bodyfit"].search.pose_lower_deg == (-25.0, -25.0, -10.0, -10.0)
+    assert METHODS["thorough"].search.pose_lower_deg == (-10.0,) * 4
+    assert METHODS["paper"].search.pose_lower_deg == (-10.0,) * 4
+    before = fit_settings(METHODS["bodyfit"], {"arms_lower_deg": -10.0})
+    assert before.search.pose_lower_deg == (-10.0,) * 4
