@@ -276,12 +276,14 @@ class PopulationEvaluator:
             raise ValueError(f"posed bodies are needed for the views {sorted(names)}, "
                              f"got {sorted(posed)}")
         shapes = {np.shape(bodies) for bodies in posed.values()}
-        count = next(iter(shapes))[0] if len(shapes) == 1 else 0
-        if len(shapes) != 1 or next(iter(shapes))[1:] != (self.model.num_vertices, 3):
+        count = len(next(iter(posed.values())))
+        if shapes != {(count, self.model.num_vertices, 3)}:
             raise ValueError(f"posed bodies must be (P, {self.model.num_vertices}, 3), "
                              f"got {sorted(shapes)}")
-        if not self._workspaces or self._workspaces[0].capacity < count:
-            self._workspaces = [_Workspace(self.model, self._pose_groups, count)]
+        if not self._workspaces:
+            self._workspaces.append(_Workspace(self.model, self._pose_groups, count))
+        elif self._workspaces[0].capacity < count:  # the others keep theirs
+            self._workspaces[0] = _Workspace(self.model, self._pose_groups, count)
         space = self._workspaces[0]
         self._clock = self._timer()
         term_costs, costs = space.term_costs[:count], space.costs[:count]

@@ -17,14 +17,13 @@ import numpy as np
 from PIL import ExifTags, Image
 
 from bodyfit.calib.camera import Camera
+from bodyfit.calib.images import FULL_FRAME_DIAGONAL_MM
 from bodyfit.common.files import write_atomic
 from bodyfit.fitter.demo.studio_photos import lens_photo
 from bodyfit.fitter.model.body_model import PART_NAMES, BodyModel
 
 __all__ = ["PhotoEffects", "Shot", "exif_focal", "record", "write_photos"]
 
-#: A full-frame (35 mm film) diagonal, mm: EXIF's FocalLengthIn35mmFilm scales by it.
-FULL_FRAME_DIAGONAL_MM = 43.27
 #: The phone sensor's diagonal assumed for EXIF's FocalLength, mm (a 1/1.7" sensor).
 _SENSOR_DIAGONAL_MM = 9.5
 

@@ -29,6 +29,7 @@ import functools
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from bodyfit.fitter.measure.sections import mesh_edges
 from bodyfit.fitter.model.body_model import (PART_NAMES, BodyModel, abduction_rotations,
                                              forward, rest_shape)
 from bodyfit.kernels.body_forward import blend_skinning
@@ -86,40 +87,45 @@ def _neighbour_mean_matrix(faces: np.ndarray, count: int):
     """(V, V) sparse: each vertex's mean over itself and its mesh neighbours."""
     import scipy.sparse
 
-    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    edges = mesh_edges(faces)
     rows = np.r_[edges[:, 0], edges[:, 1], np.arange(count)]
     cols = np.r_[edges[:, 1], edges[:, 0], np.arange(count)]
     adjacency = scipy.sparse.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(count, count))
-    adjacency.data[:] = 1.0  # an edge shared by two faces counts once
     return scipy.sparse.diags(1.0 / np.asarray(adjacency.sum(axis=1)).ravel()) @ adjacency
+
+
+def _turns(rig: ElbowRig, flexion_deg: float):
+    """Per side: (the elbow's rotation from the rest flexion to ``flexion_deg`` (3, 3),
+    its derivative per degree (3, 3))."""
+    for axis in rig.axes:
+        turn = Rotation.from_rotvec(axis * np.deg2rad(flexion_deg - rig.rest_deg)).as_matrix()
+        cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]],
+                          [-axis[1], axis[0], 0]])
+        yield turn, cross @ turn * (np.pi / 180.0)
+
+
+def _about_elbows(rig: ElbowRig, vertices: np.ndarray, matrices) -> np.ndarray:
+    """Sum over the sides of e (M (v - c)) for bodies (..., V, 3) and each side's (3, 3)
+    ``matrices``."""
+    vertices = np.asarray(vertices, np.float64)
+    out = np.zeros_like(vertices)
+    for weights, ring, matrix in zip(rig.weights, rig.rings, matrices):
+        centre = vertices[..., ring, :].mean(axis=-2, keepdims=True)
+        out += weights[:, None] * ((vertices - centre) @ matrix.T)
+    return out
 
 
 def bent(rig: ElbowRig, vertices: np.ndarray, flexion_deg: float) -> np.ndarray:
     """Bodies (..., V, 3) (or shape directions) with both elbows at ``flexion_deg``
     instead of the rest pose's (module docstring); float64."""
-    vertices = np.asarray(vertices, np.float64)
-    out = vertices.copy()
-    for side in range(2):
-        turn = Rotation.from_rotvec(rig.axes[side] * np.deg2rad(flexion_deg - rig.rest_deg))
-        centre = vertices[..., rig.rings[side], :].mean(axis=-2, keepdims=True)
-        out += rig.weights[side][:, None] * ((vertices - centre) @ (turn.as_matrix() - np.eye(3)).T)
-    return out
+    return np.asarray(vertices, np.float64) + _about_elbows(
+        rig, vertices, [turn - np.eye(3) for turn, _ in _turns(rig, flexion_deg)])
 
 
 def bend_derivative(rig: ElbowRig, vertices: np.ndarray, flexion_deg: float) -> np.ndarray:
     """(..., V, 3) float64: d :func:`bent` / d flexion, metres per degree, of bodies
     (..., V, 3)."""
-    vertices = np.asarray(vertices, np.float64)
-    out = np.zeros_like(vertices)
-    for side in range(2):
-        axis = rig.axes[side]
-        turn = Rotation.from_rotvec(axis * np.deg2rad(flexion_deg - rig.rest_deg)).as_matrix()
-        cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]],
-                          [-axis[1], axis[0], 0]])
-        centre = vertices[..., rig.rings[side], :].mean(axis=-2, keepdims=True)
-        d_turn = cross @ turn * np.pi / 180.0  # d R / d degree
-        out += rig.weights[side][:, None] * ((vertices - centre) @ d_turn.T)
-    return out
+    return _about_elbows(rig, vertices, [d_turn for _, d_turn in _turns(rig, flexion_deg)])
 
 
 def elbow_forward(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
