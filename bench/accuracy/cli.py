@@ -161,8 +161,8 @@ def fit(args, batch_options: list[str]) -> None:
         table = folder / (f"subjects-rows{args.skip}-{args.first - 1}.csv" if args.skip
                           else f"subjects-first{args.first}.csv")
         table.write_text("".join(_table_rows(folder, args.first, True, args.skip)))
-    # a table with a camera column names each subject's camera itself (standing sets)
-    per_row = "camera" in (folder / "subjects.csv").read_text().splitlines()[0].split(",")
+    # a set with uncalibrated subjects names each subject's camera in its table
+    per_row = read_settings(folder).per_row_camera
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
                *(["--camera", str(camera)] if args.camera == "calibrated" and not per_row
                  else []),

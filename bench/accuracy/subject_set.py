@@ -94,6 +94,11 @@ class SetSettings:
     exif_share: float = 0.0
     stance: StanceSettings = StanceSettings()
 
+    @property
+    def per_row_camera(self) -> bool:
+        """subjects.csv names each subject's camera (some have none: ``exif_share``)."""
+        return self.exif_share > 0
+
     @classmethod
     def standing(cls, count: int, seed: int, **overrides) -> "SetSettings":
         """The ``standing`` set's protocol (issue 58): cameras 2-4 m away, 0.8-1.6 m high,
@@ -181,7 +186,7 @@ def write_photos_of_set(model: BodyModel, folder: Path, subjects: list[int] | No
             progress.update(1)
     table = io.StringIO()
     writer = csv.writer(table, lineterminator="\n")
-    per_row_camera = settings.exif_share > 0
+    per_row_camera = settings.per_row_camera
     writer.writerow(["id", "front", "side", "height_cm", "sex"]
                     + (["camera"] if per_row_camera else []))
     for subject, sex in zip(ids, bodies.sex):
