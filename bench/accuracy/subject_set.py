@@ -47,6 +47,7 @@ from bodyfit.common.files import write_atomic
 from bodyfit.fitter.demo.example import demo_camera
 from bodyfit.fitter.fit.pinhole_canvas import Placement
 from bodyfit.fitter.measure.measurements import MEASUREMENTS, Measurer
+from bodyfit.fitter.model_build.body_sample import ANNY_GENDER
 from bodyfit.fitter.model.body_model import BodyModel
 from bodyfit.fitter.output.render import pinhole_pixels
 from bodyfit.fitter.output.result_files import write_json
@@ -235,7 +236,7 @@ def _standing_photos(model: BodyModel, bodies: Bodies, index: int, settings: Set
     ``standing`` subject: posed by Anny's skeleton (:mod:`.stances`), each view from its
     own hand-held place, with or without calibration (module docstring)."""
     source, skeleton = _anny()
-    gender = np.array([1.0 if bodies.sex[index] == "female" else 0.0])  # Anny's convention
+    gender = np.array([ANNY_GENDER[bodies.sex[index]]])
     rest, heads = source.rest_bodies(gender, bodies.anny_params[index][None], all_bones=True)
     if np.abs(rest[0] - bodies.vertices[index]).max() > 1e-4:
         raise ValueError("bodies.npz's Anny parameters do not make its bodies: another "

@@ -33,12 +33,13 @@ from bodyfit.fitter.measure.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_build.anny_source import PHENOTYPES, SHAPE_PARAMETERS, AnnySource
 
 __all__ = ["SEXES", "TARGET_KEYS", "ReferenceStats", "SamplingSettings", "BodySample",
-           "BodySampler"]
+           "BodySampler", "ANNY_GENDER"]
 
 logger = logging.getLogger(__name__)
 
 SEXES = ("male", "female")
-_GENDER = {"male": 0.0, "female": 1.0}  # Anny's gender phenotype
+#: Anny's gender phenotype of each sex.
+ANNY_GENDER = {"male": 0.0, "female": 1.0}
 #: Measurements the sample's bodies are fitted to (see the module docstring).
 TARGET_KEYS = ("A", "B", "D", "E", "F", "G", "J", "K", "L", "M", "N", "O", "P")
 _KEYS = list(MEASUREMENTS)
@@ -152,7 +153,7 @@ class BodySampler:
         return np.clip(centre + noise, lo, hi)
 
     def _bodies(self, sex: str, params: np.ndarray, progress=None):
-        gender = np.full(len(params), _GENDER[sex])
+        gender = np.full(len(params), ANNY_GENDER[sex])
         vertices, joints = self.source.rest_bodies(gender, params)
         measured = self.measurer.measure_many(vertices)
         if progress is not None:
