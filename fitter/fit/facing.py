@@ -6,11 +6,13 @@ shows them facing the image's right; its mirror image is, for a left-right symme
 body, the photo from the left that the fit expects (the model's bodies are symmetric;
 :func:`bodyfit.fitter.fit.person.person_masks` mirrors such a mask and its camera).
 
-The cue is the feet: seen from the side, each foot reaches from the ankle far forward
-(the toes) and only a little back (the heel). The ankles' centre is the middle of the
-silhouette a little above the soles (:data:`_ANKLE_BAND`); the soles' band
-(:data:`_SOLE_BAND`) reaches further from it towards the way the person faces.
-Fractions are of the person's height in the mask.
+The cue is the feet: seen from the side, each foot reaches from the leg far forward (the
+toes) and only a little back (the heel). The legs' axis is the median centre of the
+silhouette's rows across the shins (:data:`_SHIN_BAND`, where the two legs overlap); the
+feet's band (:data:`_FEET_BAND`) reaches further from it towards the way the person
+faces. The shins, not the ankles, give the axis: a camera above the floor sees the far
+foot higher in the photo than the near one, and its toes then reach into the ankles'
+rows. Fractions are of the person's height in the mask.
 """
 
 from __future__ import annotations
@@ -21,16 +23,17 @@ __all__ = ["FACING_MARGIN", "SIDES", "facing_reach", "side_seen"]
 
 #: Which side of the person a side photo shows: "left" faces the image's left.
 SIDES = ("left", "right")
-_SOLE_BAND = (0.0, 0.025)  # rows above the lowest person row, fraction of the height
-_ANKLE_BAND = (0.05, 0.08)
+_FEET_BAND = (0.0, 0.05)  # rows above the lowest person row, fraction of the height
+_SHIN_BAND = (0.12, 0.2)
 #: The toes must reach this much further (fraction of the height) one way than the
-#: heels the other for the facing to be told.
-FACING_MARGIN = 0.02
+#: heels the other for the facing to be told. The standing set's 200 side photos read
+#: 0.067-0.11 towards the way the person faces, their front photos under 0.02.
+FACING_MARGIN = 0.04
 
 
 def facing_reach(mask: np.ndarray) -> float:
-    """How much further the soles reach left than right of the ankles, as a fraction of
-    the person's height in ``mask`` (H, W) bool: positive faces the image's left."""
+    """How much further the feet reach left than right of the legs' axis, as a fraction
+    of the person's height in ``mask`` (H, W) bool: positive faces the image's left."""
     rows = np.flatnonzero(mask.any(axis=1))
     top, bottom = rows[0], rows[-1]
     height = bottom - top + 1
@@ -39,12 +42,15 @@ def facing_reach(mask: np.ndarray) -> float:
         lo, hi = (int(round(bottom - f * height)) for f in fractions[::-1])
         return mask[max(lo, top):hi + 1]
 
-    ankles = np.flatnonzero(band(_ANKLE_BAND).any(axis=0))
-    soles = np.flatnonzero(band(_SOLE_BAND).any(axis=0))
-    if ankles.size == 0 or soles.size == 0:
+    shins = band(_SHIN_BAND)
+    shins = shins[shins.any(axis=1)]
+    feet = np.flatnonzero(band(_FEET_BAND).any(axis=0))
+    if shins.size == 0 or feet.size == 0:
         return 0.0
-    centre = (ankles[0] + ankles[-1]) / 2
-    return float((centre - soles[0]) - (soles[-1] - centre)) / height
+    first = shins.argmax(axis=1)
+    last = shins.shape[1] - 1 - shins[:, ::-1].argmax(axis=1)
+    centre = float(np.median((first + last) / 2))
+    return float((centre - feet[0]) - (feet[-1] - centre)) / height
 
 
 def side_seen(mask: np.ndarray) -> str | None:

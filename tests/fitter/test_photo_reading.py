@@ -46,10 +46,12 @@ def _inputs(folder, truth, side="side.png", camera=True, front="front.png"):
 
 
 def test_side_seen_from_the_feet_of_a_drawn_profile():
-    """A drawn profile: a leg column and a foot reaching forward nearly 3x as far as back."""
+    """A drawn profile: a leg column and feet reaching forward nearly 3x as far as back; the
+    far foot seen higher than the near one, as from a camera above the floor."""
     mask = np.zeros((400, 300), bool)
     mask[50:390, 140:160] = True  # body and leg, 340 px tall, centre column 149.5
     mask[382:390, 100:168] = True  # the foot: toes 49.5 px left of the centre, heel 17.5 right
+    mask[368:376, 104:168] = True  # the far foot, 14 px (4 % of the height) higher
     assert facing_reach(mask) == pytest.approx((49.5 - 17.5) / 340)
     assert side_seen(mask) == "left" and side_seen(mask[:, ::-1]) == "right"
     mask[382:390, 100:200] = True  # toes and heel alike: the feet do not tell
