@@ -46,7 +46,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
         parser.add_argument("--front", metavar="PHOTO", help="front photo, A-pose (required "
                             "without --config)")
         parser.add_argument("--side", metavar="PHOTO",
-                            help="side photo (the person's left side), arms hanging down")
+                            help="side photo from the person's left or right, arms hanging down")
         parser.add_argument("--height-cm", type=float, metavar="CM",
                             help="the person's stature, centimetres")
         parser.add_argument("-o", "--output", type=Path, metavar="OUT",
