@@ -114,7 +114,8 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "from the mean body; --method thorough: 2, paper: 1)")
     parser.add_argument("--iterations", type=int,
                         help="the local solver's iterations at most, after the searches "
-                             "(default 10; 0: none; --method thorough and paper: 0)")
+                             "(default 40, fewer where the cost stops falling; 10: the default "
+                             "before; 0: none; --method thorough and paper: 0)")
     parser.add_argument("--start", choices=("mean", "learned"),  # local_solver.SOLVER_STARTS
                         help="where the local solver starts without a search: learned (the "
                              "default: the body a regression reads off the silhouettes; with "

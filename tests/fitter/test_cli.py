@@ -62,7 +62,7 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     record = json.loads((out_dir / "fit" / "run.json").read_text())
     assert record["settings"]["projection"] == "pinhole"
     assert record["settings"]["search"]["searches"] == 0
-    assert record["settings"]["solver"]["iterations"] == 10
+    assert record["settings"]["solver"]["iterations"] == 40
     assert record["settings"]["solver"]["start"] == "learned"
     assert len(record["result"]["betas"]) == 40
     assert record["inputs"]["camera"] == "demo/camera.json"
