@@ -116,6 +116,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="the local solver's iterations at most, after the searches "
                              "(default 40, fewer where the cost stops falling; 10: the default "
                              "before; 0: none; --method thorough and paper: 0)")
+    parser.add_argument("--placements-within", type=int, metavar="N",
+                        help="the local solver places the cameras anew from its body 3 "
+                             "times, evenly within its first N iterations (default 10; 0: "
+                             "through all of them, the default before)")
     parser.add_argument("--start", choices=("mean", "learned"),  # local_solver.SOLVER_STARTS
                         help="where the local solver starts without a search: learned (the "
                              "default: the body a regression reads off the silhouettes; with "

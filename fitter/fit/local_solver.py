@@ -32,8 +32,8 @@ it they are a mask's stray pixels, which must not pull the whole body.
 The stature is held as the search holds it: the first beta is solved from the others
 (:class:`~bodyfit.fitter.fit.stature.StatureConditioner`), its slope with respect to them
 entering the Jacobian. The pinhole cameras are solved with the body, and may be placed
-anew from the body so far (``placements`` times, evenly through the iterations) as the
-search places them.
+anew from the body so far (``placements`` times, evenly through the first
+``placements_within`` iterations) as the search places them.
 
 The Jacobian is analytic (:meth:`~bodyfit.fitter.fit.outline.ViewOutline.jacobian`); the
 steps are Gauss-Newton's on the Huber-reweighted residuals, damped by Levenberg-Marquardt,
@@ -73,7 +73,8 @@ ELBOW_RANGE_DEG = (0.0, 60.0)
 _CAMERA_REACH_M = 0.5
 
 __all__ = ["SOLVER_STARTS", "ELBOWS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
-           "signed_distance", "sample_bilinear", "LocalProblem", "solve", "moved_view"]
+           "signed_distance", "sample_bilinear", "LocalProblem", "solve", "placement_iterations",
+           "moved_view"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -90,7 +91,10 @@ class SolverSettings:
             largest misfits, such as legs at another angle, carry the information; near
             it, they are a mask's stray pixels).
         placements: how often the pinhole cameras are placed anew from the body so far,
-            evenly through the iterations.
+            evenly through the first ``placements_within`` iterations.
+        placements_within: the iterations the placements are spread over (0: all of
+            them); a placement moves the cameras off the cost's minimum, so the last one
+            leaves the solver the rest of its iterations to come back.
         person_to_model: the share of the person -> model term in each view's cost (the
             rest is the model -> person term's).
         tolerance: stop when an accepted step lowers the cost by less than this share.
@@ -107,6 +111,7 @@ class SolverSettings:
     huber_mm: float = 3.0
     huber_start_mm: float = 30.0
     placements: int = 3
+    placements_within: int = 0
     person_to_model: float = 0.5
     tolerance: float = 1e-5
     start: str = "mean"
@@ -119,7 +124,7 @@ class SolverSettings:
             raise UserError(f"the local solver's components must be 2-{stored_components}, "
                             f"got {self.components}")
         if (self.prior < 0 or self.huber_mm <= 0 or self.placements < 0
-                or self.huber_start_mm < self.huber_mm):
+                or self.placements_within < 0 or self.huber_start_mm < self.huber_mm):
             raise UserError("the solver's prior and placements must be >= 0 and its "
                             "Huber knees > 0, the first at least the last")
         if not 0 <= self.person_to_model <= 1:
@@ -377,7 +382,7 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
     s = problem.settings
     x = problem.start(start)
     trace = SolverTrace()
-    at = {round(s.iterations * (i + 1) / (s.placements + 1)) for i in range(s.placements)}
+    at = placement_iterations(s)
     damping = 1e-3
     prior = np.zeros(len(x))
     prior[:problem.k - 1] = s.prior
@@ -424,6 +429,13 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
     else:
         trace.stop_reason = "iterations"
     return x, trace
+
+
+def placement_iterations(settings: SolverSettings) -> set[int]:
+    """The iterations (0-based) before which the cameras are placed anew: ``placements`` of
+    them, evenly within the first ``placements_within`` iterations (all, when 0)."""
+    span = min(settings.iterations, settings.placements_within or settings.iterations)
+    return {round(span * (i + 1) / (settings.placements + 1)) for i in range(settings.placements)}
 
 
 def moved_view(view: kernels.ViewTarget, translation_m: np.ndarray) -> kernels.ViewTarget:

@@ -83,7 +83,8 @@ class FitSettings:
 
     search: SearchSettings = SearchSettings(searches=0, refine_components=0,
                                             pose_lower_deg=ARMS_LOWER_DEG)
-    solver: SolverSettings = SolverSettings(iterations=40, start="learned", elbows="fitted")
+    solver: SolverSettings = SolverSettings(iterations=40, start="learned", elbows="fitted",
+                                            placements_within=10)
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="model_to_person",

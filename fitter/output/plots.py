@@ -55,9 +55,11 @@ def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label:
         return int(round(px)), int(round(top + (y_high - y) / (y_high - y_low) * (height - top - bottom)))
 
     cv2.rectangle(image, (left, top), (width - right, height - bottom), (0, 0, 0), 1)
-    if log_y:  # 1-2-5 steps per decade
+    if log_y:  # 1-2-5 steps per decade; round linear steps within less than a 1-2-5 step
         decades = np.arange(np.floor(y_low), np.ceil(y_high) + 1)
         ticks = np.log10(np.outer(10 ** decades, (1, 2, 5)).ravel())
+        if np.count_nonzero((ticks >= y_low - 1e-9) & (ticks <= y_high + 1e-9)) < 2:
+            ticks = np.log10(_ticks(10 ** y_low, 10 ** y_high))
     else:
         ticks = _ticks(y_low, y_high)
     for y in ticks:

@@ -24,7 +24,8 @@ REPORT_PICTURES = {
     "outline_side": "Side: the person's silhouette (grey) with the fitted body's outline",
     "overlay_front": "Front: matched contours (overlay_front.png)",
     "overlay_side": "Side: matched contours (overlay_side.png)",
-    "convergence": "The fit's cost per iteration or generation (convergence.png)",
+    "convergence": "The fit's cost per iteration or generation (convergence.png; the local "
+                   "solver's rises where it places the cameras anew from the body so far)",
 }
 
 _CSS = """

@@ -11,8 +11,9 @@ import pytest
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.demo.studio_photos import BACKDROP_BGR, write_pinhole_subject
 from bodyfit.fitter.fit.canvas import extreme_bodies
-from bodyfit.fitter.fit.local_solver import (LocalProblem, SolverSettings, sample_bilinear,
-                                             signed_distance, silhouette_edge, solve)
+from bodyfit.fitter.fit.local_solver import (LocalProblem, SolverSettings, placement_iterations,
+                                             sample_bilinear, signed_distance, silhouette_edge,
+                                             solve)
 from bodyfit.fitter.fit.outline import MeshEdges, ViewOutline, moved_camera, project_with_jacobian
 from bodyfit.fitter.fit.person_fit import METHODS, FitSettings
 from bodyfit.fitter.fit.pinhole_canvas import pinhole_view
@@ -196,3 +197,12 @@ def test_outline_jacobian_with_bent_elbows(body_model, subject):
     scale = np.abs(jacobian[:, :, 24]).max()
     assert scale > 0.5  # pixels per degree: the forearms' outline moves
     assert np.abs(numeric - jacobian[:, :, 24]).max() < 0.01 * scale + 2e-3
+
+
+def test_placements_fall_evenly_within_their_span():
+    """3 placements: at iterations 2, 5 and 8 of the first 10 (the default's), at 10, 20
+    and 30 of 40 through all (the default before), within 5 when only 5 run."""
+    assert placement_iterations(SolverSettings(iterations=40, placements_within=10)) == {2, 5, 8}
+    assert placement_iterations(SolverSettings(iterations=40)) == {10, 20, 30}
+    assert placement_iterations(SolverSettings(iterations=5, placements_within=10)) == {1, 2, 4}
+    assert FitSettings().solver.placements_within == 10
