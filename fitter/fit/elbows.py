@@ -104,28 +104,34 @@ def _turns(rig: ElbowRig, flexion_deg: float):
         yield turn, cross @ turn * (np.pi / 180.0)
 
 
-def _about_elbows(rig: ElbowRig, vertices: np.ndarray, matrices) -> np.ndarray:
-    """Sum over the sides of e (M (v - c)) for bodies (..., V, 3) and each side's (3, 3)
-    ``matrices``."""
-    vertices = np.asarray(vertices, np.float64)
-    out = np.zeros_like(vertices)
+def _about_elbows(rig: ElbowRig, vertices: np.ndarray, matrices, rows) -> np.ndarray:
+    """(..., N, 3) float64: the sum over the sides of e (M (v - c)) for the vertices
+    ``rows`` of bodies (..., V, 3) and each side's (3, 3) ``matrices`` (the ring centroids
+    c from the whole bodies)."""
+    vertices = np.asarray(vertices)
+    picked = np.asarray(vertices[..., rows, :], np.float64)
+    out = np.zeros_like(picked)
     for weights, ring, matrix in zip(rig.weights, rig.rings, matrices):
-        centre = vertices[..., ring, :].mean(axis=-2, keepdims=True)
-        out += weights[:, None] * ((vertices - centre) @ matrix.T)
+        centre = np.asarray(vertices[..., ring, :], np.float64).mean(axis=-2, keepdims=True)
+        out += weights[rows, None] * ((picked - centre) @ matrix.T)
     return out
 
 
-def bent(rig: ElbowRig, vertices: np.ndarray, flexion_deg: float) -> np.ndarray:
+def bent(rig: ElbowRig, vertices: np.ndarray, flexion_deg: float,
+         rows=slice(None)) -> np.ndarray:
     """Bodies (..., V, 3) (or shape directions) with both elbows at ``flexion_deg``
-    instead of the rest pose's (module docstring); float64."""
-    return np.asarray(vertices, np.float64) + _about_elbows(
-        rig, vertices, [turn - np.eye(3) for turn, _ in _turns(rig, flexion_deg)])
+    instead of the rest pose's (module docstring), float64: (..., N, 3), the vertices
+    ``rows`` only (default all)."""
+    return np.asarray(np.asarray(vertices)[..., rows, :], np.float64) + _about_elbows(
+        rig, vertices, [turn - np.eye(3) for turn, _ in _turns(rig, flexion_deg)], rows)
 
 
-def bend_derivative(rig: ElbowRig, vertices: np.ndarray, flexion_deg: float) -> np.ndarray:
-    """(..., V, 3) float64: d :func:`bent` / d flexion, metres per degree, of bodies
-    (..., V, 3)."""
-    return _about_elbows(rig, vertices, [d_turn for _, d_turn in _turns(rig, flexion_deg)])
+def bend_derivative(rig: ElbowRig, vertices: np.ndarray, flexion_deg: float,
+                    rows=slice(None)) -> np.ndarray:
+    """(..., N, 3) float64: d :func:`bent` / d flexion, metres per degree, of the vertices
+    ``rows`` (default all) of bodies (..., V, 3)."""
+    return _about_elbows(rig, vertices, [d_turn for _, d_turn in _turns(rig, flexion_deg)],
+                         rows)
 
 
 def elbow_forward(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,

@@ -346,8 +346,7 @@ class LocalProblem:
             # columns of d_pixels: K betas, 4 angles, the flexion if fitted, 3 camera
             d_points[:, :, :self.camera_start] = np.concatenate(
                 [d_pixels[:, :, 1:self.k] + d_pixels[:, :, :1] * slope[None, None],
-                 d_pixels[:, :, self.k:self.k + self.camera_start - self.num_genes + 4]],
-                axis=2)
+                 d_pixels[:, :, self.k:-3]], axis=2)
             d_points[:, :, first:first + 3] = d_pixels[:, :, -3:]
             if reading.gradients is not None:
                 rows.append(mm * np.einsum("si,sik->sk", reading.gradients, d_points))

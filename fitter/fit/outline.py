@@ -172,10 +172,10 @@ def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarra
         rest = rest[0, vertices].astype(np.float64)
         dirs = vertex_dirs[:, vertices].astype(np.float64)
     else:
-        rig = elbow_rig(model)
-        d_flexion = bend_derivative(rig, rest[0], flexion_deg)[vertices]
-        rest = bent(rig, rest[0], flexion_deg)[vertices]
-        dirs = bent(rig, vertex_dirs, flexion_deg)[:, vertices]
+        rig = elbow_rig(model)  # only the wanted vertices bent (the rings' centroids whole)
+        d_flexion = bend_derivative(rig, rest[0], flexion_deg, vertices)
+        rest = bent(rig, rest[0], flexion_deg, vertices)
+        dirs = bent(rig, vertex_dirs, flexion_deg, vertices)
     dirs = dirs.transpose(1, 2, 0)  # (N, 3, K)
     rotations = abduction_rotations(np.asarray(pose_deg, np.float64)[None])[0]  # (4, 3, 3)
     weights = model.chain_weights[vertices].astype(np.float64)  # (N, 4)
