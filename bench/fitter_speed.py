@@ -32,17 +32,21 @@ from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.output.plots import line_chart
 
 #: name -> `fitter run` options: bodyfit's default (the local solver from the learned
-#: start, 40 iterations at most) and other iteration budgets, the learned start alone,
+#: start, 40 iterations at most, the cameras' pitch searched), the same with the cameras
+#: level (the default before) and at other iteration budgets, the learned start alone,
 #: the solver from the mean body (40 iterations, the default before the learned start), the
 #: population search that was the default before that (``thorough``) at its full budget
 #: and at one search alone, and the paper's method at two budgets.
 SETTINGS = {
     "bodyfit: the learned start alone": ["--iterations", "0"],
-    "bodyfit: 5 iterations": ["--iterations", "5"],
-    "bodyfit: 10 iterations (the default before)": ["--iterations", "10"],
-    "bodyfit: 10 iterations, the elbows at rest": ["--iterations", "10", "--elbows", "rest"],
-    "bodyfit (default): 40 iterations": [],
-    "bodyfit from the mean body: 40 iterations": ["--start", "mean", "--iterations", "40"],
+    "bodyfit: 5 iterations, cameras level": ["--iterations", "5", "--pitch", "level"],
+    "bodyfit: 10 iterations, cameras level": ["--iterations", "10", "--pitch", "level"],
+    "bodyfit: 10 iterations, cameras level, the elbows at rest": [
+        "--iterations", "10", "--pitch", "level", "--elbows", "rest"],
+    "bodyfit: 40 iterations, cameras level (the default before)": ["--pitch", "level"],
+    "bodyfit (default): 40 iterations, the cameras' pitch searched": [],
+    "bodyfit from the mean body: 40 iterations": ["--start", "mean", "--iterations", "40",
+                                                  "--pitch", "level"],
     "thorough: one search 30 x 150": ["--method", "thorough", "--searches", "1",
                                       "--refine-components", "0"],
     "thorough (the default before)": ["--method", "thorough"],

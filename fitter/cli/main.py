@@ -132,6 +132,11 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="the local solver's elbows: fitted (the default: one flexion "
                              "for both arms and photos, solved with the body) or rest (the "
                              "model's rest pose's, about 43 degrees)")
+    parser.add_argument("--pitch", choices=("searched", "level"),  # pitch.PITCHES
+                        help="the cameras' pitch: searched (the default: the local solver "
+                             "run again with each camera pitched 4 degrees down and up, the "
+                             "best-scored answer kept; about twice the time) or level (both "
+                             "cameras level, the default before)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
                              "first K components, --refinements of them, averaged (more "
@@ -386,8 +391,11 @@ def _cmd_demo(args) -> None:
 
 def _photos_line(fit) -> str:
     """What was read of the photos besides the silhouettes, for the summary."""
+    from bodyfit.fitter.fit.pitch import pitch_text
+    pitch = fit.photos.get("pitch_deg")
     return (f"  camera: {fit.photos['camera']}; the side photo shows the person's "
-            f"{fit.photos['side_from']} side")
+            f"{fit.photos['side_from']} side"
+            + (f"; the cameras' pitch: {pitch_text(pitch)}" if pitch else ""))
 
 
 def _run_settings(args):

@@ -52,6 +52,7 @@ from scipy.spatial import cKDTree
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.elbows import elbow_forward, elbow_rig
 from bodyfit.fitter.fit.outline import OutlineSamples, ViewOutline, moved_camera
+from bodyfit.fitter.fit.pitch import PITCHES
 from bodyfit.fitter.model.body_model import BodyModel
 from bodyfit import kernels
 
@@ -103,6 +104,9 @@ class SolverSettings:
             off the silhouettes (:mod:`bodyfit.fitter.fit.learned_start`; with 0
             iterations, that body is the answer).
         elbows: one of ``ELBOWS``; a fitted flexion starts at the rest pose's.
+        pitch: the pinhole cameras' pitch, one of ``pitch.PITCHES``: ``"searched"``, the
+            solver run again with each view's camera pitched
+            (:mod:`bodyfit.fitter.fit.pitch`), or ``"level"``.
     """
 
     iterations: int = 0
@@ -116,6 +120,7 @@ class SolverSettings:
     tolerance: float = 1e-5
     start: str = "mean"
     elbows: str = "rest"
+    pitch: str = "level"
 
     def validate(self, stored_components: int) -> None:
         if self.iterations < 0:
@@ -134,6 +139,8 @@ class SolverSettings:
                             f"got {self.start!r}")
         if self.elbows not in ELBOWS:
             raise UserError(f"--elbows must be one of {', '.join(ELBOWS)}, got {self.elbows!r}")
+        if self.pitch not in PITCHES:
+            raise UserError(f"--pitch must be one of {', '.join(PITCHES)}, got {self.pitch!r}")
 
 
 def silhouette_edge(mask: np.ndarray) -> np.ndarray:
@@ -266,10 +273,11 @@ class LocalProblem:
         self.upper = np.r_[np.full(self.k - 1, beta_limit), pose_upper_deg,
                            np.array(elbow)[:, 1], np.full(3 * len(views), _CAMERA_REACH_M)]
 
-    def start(self, genes: np.ndarray) -> np.ndarray:
-        """The parameters of ``genes`` (K - 1 + 4,): the elbows at the rest pose's, the
-        cameras where they stand."""
-        elbow = [self.rig.rest_deg] if self.rig is not None else []
+    def start(self, genes: np.ndarray, flexion_deg: float | None = None) -> np.ndarray:
+        """The parameters of ``genes`` (K - 1 + 4,): the elbows at ``flexion_deg`` (None:
+        the rest pose's), the cameras where they stand."""
+        elbow = ([self.rig.rest_deg if flexion_deg is None else flexion_deg]
+                 if self.rig is not None else [])
         return np.clip(np.r_[genes, elbow, np.zeros(3 * len(self.names))], self.lower,
                        self.upper)
 
@@ -365,12 +373,14 @@ class LocalProblem:
         return float(residuals.weights @ rho + self.settings.prior * betas @ betas)
 
 
-def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndarray, SolverTrace]:
+def solve(problem: LocalProblem, start: np.ndarray, place=None,
+          flexion_deg: float | None = None) -> tuple[np.ndarray, SolverTrace]:
     """Levenberg-Marquardt from ``start`` (genes (K - 1 + 4,); the cameras where they stand).
 
     Args:
         problem: the person's cost.
         start: the genes to start from.
+        flexion_deg: the fitted elbows' flexion to start from (None: the rest pose's).
         place: None, or called with :meth:`LocalProblem.body`'s (betas (K,), pose (4,),
             flexion) to place the cameras anew (it calls ``problem.replace_view``),
             ``settings.placements`` times.
@@ -379,7 +389,7 @@ def solve(problem: LocalProblem, start: np.ndarray, place=None) -> tuple[np.ndar
         (the solved parameters (:class:`LocalProblem`'s order), the trace).
     """
     s = problem.settings
-    x = problem.start(start)
+    x = problem.start(start, flexion_deg)
     trace = SolverTrace()
     at = placement_iterations(s)
     damping = 1e-3

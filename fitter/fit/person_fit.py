@@ -22,7 +22,8 @@ from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
-from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew
+from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew, view_pitch_deg
+from bodyfit.fitter.fit.pitch import PITCH_ITERATIONS, searched_pitches
 from bodyfit.fitter.fit.render_mesh import render_model
 from bodyfit.fitter.fit.search import (SearchResult, SearchSettings, averaged, refined, search,
                                        searches_together)
@@ -84,7 +85,7 @@ class FitSettings:
     search: SearchSettings = SearchSettings(searches=0, refine_components=0,
                                             pose_lower_deg=ARMS_LOWER_DEG)
     solver: SolverSettings = SolverSettings(iterations=40, start="learned", elbows="fitted",
-                                            placements_within=10)
+                                            placements_within=10, pitch="searched")
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
         "bodyfit", base=kernels.CostSettings(matching="model_to_person",
@@ -101,6 +102,13 @@ class FitSettings:
     def learned_start(self) -> bool:
         """The fit starts from the learned start (no search)."""
         return self.solver.start == "learned"
+
+    @property
+    def searches_pitch(self) -> bool:
+        """The local solver searches the pinhole cameras' pitch
+        (:mod:`bodyfit.fitter.fit.pitch`)."""
+        return (self.solver.pitch == "searched" and bool(self.solver.iterations)
+                and self.projection == "pinhole")
 
     @property
     def solves(self) -> bool:
@@ -275,16 +283,18 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
 
 
 def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
-                  betas: np.ndarray, pose_deg: np.ndarray,
-                  flexion_deg: float | None = None) -> None:
+                  betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None = None,
+                  pitches: dict[str, float] | None = None) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
     degrees, elbows' flexion or None) as it is rendered (:func:`placement_body`,
-    :func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`); updates ``views`` and the
+    :func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`), pitched by ``pitches`` (view
+    name -> degrees; None: each camera keeps its pitch); updates ``views`` and the
     evaluator."""
     for name, view in views.items():
         body = placement_body(model, betas, pose_deg, view, stature_m,
                               settings.search.condition_stature, flexion_deg)
-        views[name] = placed_anew(view, masks[name], intrinsics[name], body)
+        views[name] = placed_anew(view, masks[name], intrinsics[name], body,
+                                  None if pitches is None else pitches[name])
         evaluator.replace_view(views[name])
 
 
@@ -408,12 +418,15 @@ def learned_genes(model: BodyModel, masks: dict[str, np.ndarray], stature_m: flo
 
 
 def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitSettings,
-            first: SearchResult | None, canvas_bodies: np.ndarray) -> SearchResult:
+            first: SearchResult | None, canvas_bodies: np.ndarray,
+            warm: SearchResult | None = None,
+            pitches: dict[str, float] | None = None) -> SearchResult:
     """The local solver's answer (:mod:`bodyfit.fitter.fit.local_solver`), started from
-    ``first``'s (the searches' answer), or without one from the mean body or the learned
-    start (:func:`learned_genes`, the cameras placed for it first; ``sex``: the person's,
-    or "unknown"), the pinhole cameras placed anew from its body ``solver.placements``
-    times; joined to ``first`` by
+    ``warm``'s body (an earlier solve's, the cameras placed for it first with ``pitches``,
+    view name -> degrees, None: as they are), else from ``first``'s (the searches' answer),
+    else from the mean body or the learned start (:func:`learned_genes`, the cameras
+    placed for it first; ``sex``: the person's, or "unknown"), the pinhole cameras placed
+    anew from its body ``solver.placements`` times; joined to ``first`` by
     :func:`~bodyfit.fitter.fit.search.refined`. Updates ``views`` to the cameras as
     solved, and scores the answer with the search's cost there (its ``cost``, from which
     the calibrated ± is read). ``canvas_bodies``: the extreme bodies the canvases cover
@@ -430,23 +443,28 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
                            conditioner, solver.components, s.pose_lower_deg, s.pose_upper_deg,
                            s.beta_limit, solver)
     start = np.zeros(problem.num_genes)
-    if first is not None:
+    if warm is not None:
+        start = np.r_[np.r_[warm.betas, np.zeros(solver.components)][1:solver.components],
+                      warm.pose_deg]
+    elif first is not None:
         betas = np.r_[first.betas, np.zeros(solver.components)][:solver.components]
         start = np.r_[betas[1:], first.pose_deg]
     elif settings.learned_start:
         start = np.clip(learned_genes(model, masks, stature_m, sex, solver.components),
                         problem.lower[:problem.num_genes], problem.upper[:problem.num_genes])
 
-    def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None) -> None:
+    def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None,
+              turned: dict[str, float] | None = None) -> None:
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
-                      pose_deg, flexion_deg)
+                      pose_deg, flexion_deg, turned)
         for view in views.values():
             problem.replace_view(view)
 
     pinhole = settings.projection == "pinhole"
-    if settings.learned_start and pinhole:  # the cameras placed for the start's body
-        place(*problem.body(problem.start(start)))
-    solved, trace = solve(problem, start, place if pinhole else None)
+    start_flexion = None if warm is None else warm.elbow_deg
+    if (warm is not None or settings.learned_start) and pinhole:  # placed for the start
+        place(*problem.body(problem.start(start, start_flexion)), pitches)
+    solved, trace = solve(problem, start, place if pinhole else None, start_flexion)
     betas, pose, flexion = problem.body(solved)
     for name, move in problem.camera_moves(solved).items():
         views[name] = moved_view(views[name], move)
@@ -472,6 +490,30 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         seconds=time.perf_counter() - began, stop_reasons={"solver": trace.stop_reason},
         elbow_deg=flexion)
     return result if first is None else refined(first, result)
+
+
+def _pitch_searched(model, views, masks, intrinsics, stature_m, sex: str,
+                    settings: FitSettings, level: SearchResult,
+                    canvas_bodies: np.ndarray) -> SearchResult:
+    """The answer of the cameras' pitch search (:mod:`bodyfit.fitter.fit.pitch`) from
+    ``level``, the local solver's answer with both cameras level (arguments as
+    :func:`_solved`'s); its ``evaluations`` count every solve's renders. Updates ``views``
+    to the cameras the answer was solved with."""
+    short = dataclasses.replace(settings, solver=dataclasses.replace(
+        settings.solver, iterations=min(PITCH_ITERATIONS, settings.solver.iterations)))
+    evaluations = [level.evaluations]
+
+    def solve_at(pitches: dict[str, float], start):
+        tried = dict(views)
+        result = _solved(model, tried, masks, intrinsics, stature_m, sex, short, None,
+                         canvas_bodies, start[0],
+                         {name: pitches.get(name, 0.0) for name in views})
+        evaluations.append(result.evaluations)
+        return result.cost, (result, tried)
+
+    (answer, answer_views), _ = searched_pitches(solve_at, (level.cost, (level, dict(views))))
+    views.update(answer_views)
+    return dataclasses.replace(answer, evaluations=sum(evaluations))
 
 
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
@@ -504,7 +546,8 @@ def view_photos(settings: FitSettings, views: dict[str, kernels.ViewTarget],
     if not (settings.photo_extents and settings.projection == "pinhole"):
         return None
     return {name: ViewPhoto(name, masks[name], intrinsics[name], view_bodies[name],
-                            view.visible_parts) for name, view in views.items()}
+                            view.visible_parts, pitch_deg=view_pitch_deg(view))
+            for name, view in views.items()}
 
 
 def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSettings,
@@ -561,6 +604,9 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     if settings.solves:
         result = _solved(model, views, masks, intrinsics, stature_m, sex, settings, result,
                          bodies)
+        if settings.searches_pitch:
+            result = _pitch_searched(model, views, masks, intrinsics, stature_m, sex,
+                                     settings, result, bodies)
     t2 = time.perf_counter()
     posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
                                              stature_m, s.condition_stature,
@@ -585,7 +631,8 @@ def fit_work(settings: FitSettings, result: SearchResult) -> str:
     s = settings.search
     if not s.searches:
         start = " from the learned start" if settings.learned_start else ""
-        return (f"local solver{start}, {result.generations} iterations "
+        pitch = ", then the cameras' pitch searched" if settings.searches_pitch else ""
+        return (f"local solver{start}, {result.generations} iterations{pitch} "
                 f"({result.evaluations} bodies rendered)")
     text = (f"{s.optimizer}: {result.evaluations} candidates"
             + (f", {s.searches} searches' mean" if s.searches > 1 else "")
@@ -597,7 +644,8 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
                progress: bool | None = None) -> Fit:
     """:func:`fit_person` of a person's inputs: their photos' silhouettes (or their own
     masks; a side photo from the right mirrored) and, through a pinhole camera, the
-    photos' intrinsics; ``Fit.photos`` says what was read.
+    photos' intrinsics; ``Fit.photos`` says what was read (and, through a pinhole camera,
+    ``pitch_deg``: each camera's pitch as fitted, degrees).
 
     Raises:
         UserError: the inputs' problems
@@ -606,5 +654,8 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
     photos = person_silhouettes(inputs, settings.projection)
     fit = fit_person(model, photos.masks, inputs.height_cm / 100.0, settings, progress,
                      photos.intrinsics, inputs.sex)
-    return dataclasses.replace(fit, photos={"camera": photos.camera_source or "orthographic",
-                                            "side_from": photos.side_from})
+    read = {"camera": photos.camera_source or "orthographic", "side_from": photos.side_from}
+    if settings.projection == "pinhole":
+        read["pitch_deg"] = {name: round(view_pitch_deg(view), 2) + 0.0  # not -0.0
+                             for name, view in fit.views.items()}
+    return dataclasses.replace(fit, photos=read)

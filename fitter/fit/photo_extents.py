@@ -180,6 +180,7 @@ class ViewPhoto:
         share: (H, W) float32 in [0, 1], each pixel's share of the person where the mask
             was resampled (:func:`turned_to_tape`'s warp, whose mask is this over one half),
             or None: the mask itself.
+        pitch_deg: the camera's pitch as the fit placed it, degrees (positive looks down).
     """
 
     name: str
@@ -188,6 +189,7 @@ class ViewPhoto:
     body: np.ndarray
     visible_parts: tuple[str, ...]
     share: np.ndarray | None = None
+    pitch_deg: float = 0.0
 
 
 def _runs(row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -241,7 +243,7 @@ def placed_camera(model: BodyModel, photo: ViewPhoto) -> tuple[np.ndarray, np.nd
     (:func:`~bodyfit.fitter.fit.pinhole_canvas.solve_placement` on the parts the view shows)."""
     shown = visible_vertices(model.vertex_parts, photo.visible_parts)
     placement = solve_placement(photo.name, photo.mask, np.asarray(photo.intrinsics, float),
-                                np.asarray(photo.body, np.float64)[shown])
+                                np.asarray(photo.body, np.float64)[shown], photo.pitch_deg)
     return placement.extrinsics(photo.name)
 
 

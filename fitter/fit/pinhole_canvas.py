@@ -7,19 +7,20 @@ The model of the scene, and its assumptions:
 
 - **The photo** is undistorted and upright (calib did both), so it is an ideal pinhole
   image with the camera matrix ``K`` turned as the photo was (:func:`upright_intrinsics`).
-- **The camera's axis is horizontal** and the **person stands upright** on the floor, in
-  the middle of the view's direction: the front view looks at the body's front, the side
-  view at its left side (the body facing the image's left), with the rotations of the
-  kernels' ``FRONT_VIEW_DEG`` and ``SIDE_VIEW_DEG``. A tilted phone is not modelled (a
-  5 degree tilt moves the feet's and the head's rows by about 4 per cent of the
-  distance's effect).
+- **The camera is aimed horizontally, then pitched** about its own x axis by the view's
+  ``pitch_deg`` (0 unless the fit searches it, :mod:`bodyfit.fitter.fit.pitch`); the
+  **person stands upright** on the floor, in the middle of the view's direction: the
+  front view looks at the body's front, the side view at its left side (the body facing
+  the image's left), with the rotations of the kernels' ``FRONT_VIEW_DEG`` and
+  ``SIDE_VIEW_DEG``. A phone's roll is not modelled.
 - **Placement from the stature** (:func:`solve_placement`): the mean body, scaled to the
   person's stature, stands where its highest and lowest projected points fall on the
   silhouette's top and bottom edges and its horizontal centre on the silhouette's. Those
-  two rows give two equations, linear in the person's distance and the camera's height,
-  once it is known which vertices project highest and lowest and how far in front of or
-  behind the body's axis they are (the toes are nearer the camera than the crown);
-  a few fixed-point rounds settle that. The body is posed and shown as the view renders
+  two rows (turned to a level camera's: a pitch is a turn about the camera's centre) give
+  two equations, linear in the person's distance and the camera's height, once it is
+  known which vertices project highest and lowest and how far in front of or behind the
+  body's axis they are (the toes are nearer the camera than the crown); a few
+  fixed-point rounds settle that. The body is posed and shown as the view renders
   candidates (the side view's arms hanging down, hands in front of the body: the
   horizontal centre must include them, or the camera lands 10 cm to one side and the side
   view is seen 2 degrees askew). The person's own shape differs from the scaled mean
@@ -52,7 +53,7 @@ from bodyfit.kernels.target import visible_vertices
 from bodyfit.kernels.view_camera import camera_matrices, paper_rotation
 
 __all__ = ["PHONE_HFOV_DEG", "Placement", "phone_intrinsics", "upright_intrinsics",
-           "view_rotation", "solve_placement", "pinhole_view", "placed_anew"]
+           "view_rotation", "view_pitch_deg", "solve_placement", "pinhole_view", "placed_anew"]
 
 #: Horizontal field of view across the photo's long side of the camera assumed without
 #: camera.json: a phone's main camera (26 mm equivalent focal length: 69.4 degrees).
@@ -89,18 +90,31 @@ class Placement:
         r = view_rotation(name)
         centre = (-self.distance_m * r[2] - self.lateral_m * r[0]
                   + np.array([0.0, 0.0, self.camera_height_m - self.origin_height_m]))
-        pitch, roll = np.deg2rad(self.pitch_deg), np.deg2rad(self.roll_deg)
-        tilt = (np.array([[1.0, 0.0, 0.0], [0.0, np.cos(pitch), -np.sin(pitch)],
-                          [0.0, np.sin(pitch), np.cos(pitch)]])
-                @ np.array([[np.cos(roll), -np.sin(roll), 0.0],
-                            [np.sin(roll), np.cos(roll), 0.0], [0.0, 0.0, 1.0]]))
-        r = tilt @ r
+        roll = np.deg2rad(self.roll_deg)
+        r = (_pitched(self.pitch_deg) @ np.array([[np.cos(roll), -np.sin(roll), 0.0],
+                                                  [np.sin(roll), np.cos(roll), 0.0],
+                                                  [0.0, 0.0, 1.0]]) @ r)
         return r, -r @ centre
+
+
+def _pitched(pitch_deg: float) -> np.ndarray:
+    """(3, 3) the turn of a camera frame by ``pitch_deg`` about its x axis (positive looks
+    down): level camera frame -> pitched camera frame."""
+    pitch = np.deg2rad(pitch_deg)
+    return np.array([[1.0, 0.0, 0.0], [0.0, np.cos(pitch), -np.sin(pitch)],
+                     [0.0, np.sin(pitch), np.cos(pitch)]])
 
 
 def view_rotation(name: str) -> np.ndarray:
     """(3, 3) model -> camera rotation of the ``"front"`` or ``"side"`` view (axis horizontal)."""
     return paper_rotation(_VIEW_DEG[name])
+
+
+def view_pitch_deg(view: kernels.ViewTarget) -> float:
+    """The pitch (degrees, positive looks down) of a pinhole view's camera: its rotation
+    against the level one of :func:`view_rotation` (no roll)."""
+    tilt = camera_matrices(view.camera)[1] @ view_rotation(view.name).T
+    return float(np.rad2deg(np.arctan2(tilt[2, 1], tilt[1, 1])))
 
 
 def phone_intrinsics(shape: tuple[int, int]) -> np.ndarray:
@@ -155,7 +169,7 @@ def _project(intrinsics, rotation, translation, points) -> np.ndarray:
 
 
 def solve_placement(name: str, mask: np.ndarray, intrinsics: np.ndarray,
-                    body: np.ndarray) -> Placement:
+                    body: np.ndarray, pitch_deg: float = 0.0) -> Placement:
     """The camera's placement that puts ``body`` on the silhouette (module docstring).
 
     Args:
@@ -165,17 +179,21 @@ def solve_placement(name: str, mask: np.ndarray, intrinsics: np.ndarray,
         body: (V, 3) metres, model frame: the parts the view shows of a body of the
             person's stature (the mean body scaled to it), standing on the floor at its
             lowest vertex.
+        pitch_deg: the camera's pitch (positive looks down), degrees.
     """
     k = np.asarray(intrinsics, float)
     r = view_rotation(name)
     rows, cols = np.nonzero(mask)
-    v_top, v_bottom = rows.min() - 0.5, rows.max() + 0.5  # the silhouette's edges
     u_centre = (cols.min() + cols.max()) / 2
+    # the silhouette's top and bottom edges as a level camera at the same centre sees them
+    edges = np.array([[u_centre, rows.min() - 0.5, 1.0], [u_centre, rows.max() + 0.5, 1.0]])
+    level = edges @ (k @ _pitched(pitch_deg).T @ np.linalg.inv(k)).T
+    v_top, v_bottom = level[:, 1] / level[:, 2]
     floor = body[:, 2].min()
     depth = body @ r[2]  # in front of (-) or behind (+) the body's axis, metres
     fx, fy, cy = k[0, 0], k[1, 1], k[1, 2]
     distance = fy * np.ptp(body[:, 2]) / (v_bottom - v_top)
-    placement = Placement(distance, 0.0 - floor, 0.0, -floor)
+    placement = Placement(distance, 0.0 - floor, 0.0, -floor, pitch_deg)
     for _ in range(_ROUNDS):
         px = _project(k, *placement.extrinsics(name), body)
         top, bottom = np.argmin(px[:, 1]), np.argmax(px[:, 1])
@@ -186,7 +204,8 @@ def solve_placement(name: str, mask: np.ndarray, intrinsics: np.ndarray,
         distance, height = np.linalg.solve(a, b)
         lateral = placement.lateral_m - ((px[:, 0].min() + px[:, 0].max()) / 2 - u_centre) \
             * distance / fx
-        placement = Placement(float(distance), float(height), float(lateral), float(-floor))
+        placement = Placement(float(distance), float(height), float(lateral), float(-floor),
+                              pitch_deg)
     if not 0.3 < placement.distance_m < 50:
         raise UserError(f"the {name} photo puts the person {placement.distance_m:.1f} m from "
                         "the camera; is the camera file or the stature right?")
@@ -261,7 +280,7 @@ def pinhole_view(name: str, mask: np.ndarray, intrinsics: np.ndarray, stature_m:
 
 
 def placed_anew(view: kernels.ViewTarget, mask: np.ndarray, intrinsics: np.ndarray,
-                body: np.ndarray) -> kernels.ViewTarget:
+                body: np.ndarray, pitch_deg: float | None = None) -> kernels.ViewTarget:
     """``view`` (of :func:`pinhole_view`) with the camera placed from ``body`` instead of
     the mean body: the same canvas and camera matrix, the distance and height solved by
     :func:`solve_placement` with this body's crown and toes (the search's best body so
@@ -275,8 +294,11 @@ def placed_anew(view: kernels.ViewTarget, mask: np.ndarray, intrinsics: np.ndarr
             candidate solved to the stature stands that tall posed, legs apart, so it is
             the person scaled up by a few tenths of a per cent, and its camera must
             stand as much farther).
+        pitch_deg: the camera's pitch, degrees (positive looks down); None: the view's own
+            (:func:`view_pitch_deg`).
     """
-    placement = solve_placement(view.name, mask, np.asarray(intrinsics, float), body)
+    pitch = view_pitch_deg(view) if pitch_deg is None else pitch_deg
+    placement = solve_placement(view.name, mask, np.asarray(intrinsics, float), body, pitch)
     k_canvas = camera_matrices(view.camera)[0]
     camera = kernels.pinhole_camera(k_canvas, *placement.extrinsics(view.name))
     return dataclasses.replace(view, camera=camera, millimetres_per_pixel=1000.0

@@ -13,6 +13,7 @@ import html
 import numpy as np
 
 from bodyfit.calib.images import encode_image
+from bodyfit.fitter.fit.pitch import pitch_text
 from bodyfit.fitter.fit.spreads import SPREAD_NOTES
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
 
@@ -140,6 +141,8 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
         given.append(("camera used", _e(photos["camera"])))
     if "side_from" in photos:
         given.append(("side photo", f"the person's {_e(photos['side_from'])} side"))
+    if "pitch_deg" in photos:
+        given.append(("cameras' pitch", pitch_text(photos["pitch_deg"])))
     terms = [("total", f"{result['best_cost']:.2f}")]
     terms += [(name, f"{value:.2f}") for name, value in result["part_costs"].items()]
     timings = [(stage, f"{seconds:.2f} s") for stage, seconds in record["timings_s"].items()]

@@ -64,6 +64,8 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     assert record["settings"]["search"]["searches"] == 0
     assert record["settings"]["solver"]["iterations"] == 40
     assert record["settings"]["solver"]["start"] == "learned"
+    assert record["settings"]["solver"]["pitch"] == "searched"
+    assert set(record["photos"]["pitch_deg"].values()) <= {-4.0, 0.0, 4.0}
     assert len(record["result"]["betas"]) == 40
     assert record["inputs"]["camera"] == "demo/camera.json"
     written = json.loads((out_dir / "fit" / "measurements.json").read_text())
