@@ -1,0 +1,148 @@
+"""How the cameras' pitch search was chosen (docs/accuracy.md, "People as they stand").
+
+For each subject of a standing set, the local solver's level answer (`--pitch level`) and
+eight more solves from it, each camera level or pitched ``PITCH_STEP_DEG`` down or up
+(the 3 x 3 grid, ``PITCH_ITERATIONS`` each, as the fit's search solves them), each
+measured against the truth. Then rules choosing among them, each paired against level:
+the whole grid's best score, the side or the front camera's pitch alone, and the
+default's (:func:`bodyfit.fitter.fit.pitch.searched_pitches`: each camera its best
+single-view step, the two together), each scored by cost + a prior per squared degree.
+
+    PYTHONPATH=. python -m bench.probes.pitch_grid SETS/standing --first 72 > grid.jsonl
+    PYTHONPATH=. python -m bench.probes.pitch_grid --rules grid.jsonl
+
+Errors in mm, the 7 important measurements' mean abs.; pitch in degrees, positive down.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import dataclasses
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from bodyfit.fitter.fit import person_fit
+from bodyfit.fitter.fit.canvas import extreme_bodies
+from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
+from bodyfit.fitter.fit.pitch import PITCH_ITERATIONS, PITCH_STEP_DEG
+from bodyfit.fitter.measure.measurements import IMPORTANT, Measurer
+from bodyfit.fitter.model.cache import load_model
+
+STEPS = (-PITCH_STEP_DEG, 0.0, PITCH_STEP_DEG)
+PRIORS = (0.0, 0.1, 0.2, 0.3, 0.5)
+
+
+def subject_grid(model, measurer, set_folder: Path, row: dict) -> dict:
+    """One subject's record: its true pitches and, per grid point, the answer's cost and
+    its errors (mm) by measurement letter."""
+    settings = dataclasses.replace(person_fit.METHODS["bodyfit"], threads=1)
+    settings = dataclasses.replace(settings, solver=dataclasses.replace(settings.solver,
+                                                                        pitch="level"))
+    short = dataclasses.replace(settings, solver=dataclasses.replace(
+        settings.solver, iterations=PITCH_ITERATIONS))
+    truth = json.loads((set_folder / row["id"] / "truth.json").read_text())
+    shots = truth["standing"]["shots"]
+    inputs = PersonInputs(str(set_folder / row["front"]), str(set_folder / row["side"]),
+                          float(row["height_cm"]),
+                          str(set_folder / row["camera"]) if row["camera"] else None,
+                          sex=row["sex"])
+    photos = person_silhouettes(inputs, settings.projection)
+    masks, intrinsics, stature = photos.masks, photos.intrinsics, inputs.height_cm / 100
+    s = settings.search
+    bodies = extreme_bodies(model, person_fit._canvas_components(settings), s.pose_lower_deg,
+                            s.pose_upper_deg,
+                            settings.canvas.beta_limit)
+    views = person_fit.person_views(model, masks, stature, settings, intrinsics, bodies)
+    level = person_fit._solved(model, views, masks, intrinsics, stature, inputs.sex,
+                               settings, None, bodies)
+
+    def errors(result, solved_views) -> dict:
+        _, rest, view_bodies = person_fit.fitted_bodies(
+            model, result.betas, result.pose_deg, solved_views, stature, True,
+            result.elbow_deg)
+        fitted = person_fit.fitted_measurements(model, measurer, settings, rest, view_bodies,
+                                                solved_views, masks, intrinsics)
+        return {k: float(fitted[k] - truth["measurements"][k]) for k in fitted}
+
+    grid = [{"front": 0.0, "side": 0.0, "cost": level.cost, "err": errors(level, views)}]
+    for front in STEPS:
+        for side in STEPS:
+            if front or side:
+                tried = dict(views)
+                result = person_fit._solved(model, tried, masks, intrinsics, stature,
+                                            inputs.sex, short, None, bodies, level,
+                                            {"front": front, "side": side})
+                grid.append({"front": front, "side": side, "cost": result.cost,
+                             "err": errors(result, tried)})
+    return {"id": row["id"], "true_front": shots["front"]["pitch_deg"],
+            "true_side": shots["side"]["pitch_deg"], "grid": grid}
+
+
+def _important(point: dict) -> float:
+    return float(np.mean([abs(point["err"][k]) for k in IMPORTANT]))
+
+
+def _chosen(record: dict, rule: str, prior: float) -> dict:
+    """The grid point ``rule`` chooses by cost + prior * (sum of squared pitches)."""
+    points = {(p["front"], p["side"]): p for p in record["grid"]}
+    score = {key: p["cost"] + prior * (key[0] ** 2 + key[1] ** 2) for key, p in points.items()}
+    if rule == "default":
+        best = tuple(min(STEPS, key=lambda step: score[(step, 0.0) if i == 0 else (0.0, step)])
+                     for i in range(2))
+        tried = [(0.0, 0.0)] + [(s, 0.0) for s in STEPS if s] + [(0.0, s) for s in STEPS if s]
+        keys = tried + ([best] if all(best) else [])
+    else:
+        keys = [key for key in points if rule == "grid" or
+                (rule == "side" and key[0] == 0.0) or (rule == "front" and key[1] == 0.0)]
+    return points[min(keys, key=score.get)]
+
+
+def rules_table(records: list[dict]) -> str:
+    """Markdown: each rule and prior's mean of the 7, paired against level."""
+    level = np.array([_important(r["grid"][0]) for r in records])
+    lines = [f"{len(records)} subjects, level {level.mean():.2f} mm", "",
+             "| rule | " + " | ".join(f"prior {p}" for p in PRIORS) + " |",
+             "|---|" + "---|" * len(PRIORS)]
+    for rule in ("default", "grid", "side", "front"):
+        cells = []
+        for prior in PRIORS:
+            diff = np.array([_important(_chosen(r, rule, prior)) for r in records]) - level
+            half = 1.96 * diff.std(ddof=1) / np.sqrt(len(diff))
+            cells.append(f"{level.mean() + diff.mean():.2f} ({diff.mean():+.2f} ± {half:.2f})")
+        lines.append(f"| {rule} | " + " | ".join(cells) + " |")
+    nearest = [min(r["grid"], key=lambda p: (p["front"] - r["true_front"]) ** 2
+                   + (p["side"] - r["true_side"]) ** 2) for r in records]
+    lines += ["", f"the grid point nearest the true pitches: "
+                  f"{np.mean([_important(p) for p in nearest]):.2f} mm"]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("source", type=Path, help="a standing set's folder, or with "
+                                                  "--rules the records it wrote")
+    parser.add_argument("--first", type=int, default=72)
+    parser.add_argument("--rules", action="store_true",
+                        help="read the records (JSON lines) and print the rules' table")
+    args = parser.parse_args(argv)
+    if args.rules:
+        records = [json.loads(line) for line in args.source.read_text().splitlines()
+                   if line.startswith("{")]  # not Warp's start-up lines
+        print(rules_table(records))
+        return
+    threadpool_limits(1)
+    model = load_model()
+    measurer = Measurer.from_model(model)
+    with open(args.source / "subjects.csv", newline="") as table:
+        rows = list(csv.DictReader(table))[:args.first]
+    for row in rows:
+        print(json.dumps(subject_grid(model, measurer, args.source, row)), flush=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
