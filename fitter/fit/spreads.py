@@ -6,12 +6,13 @@ Three kinds (``SPREAD_BASES``):
   the measurement's factor from ``data/spread_calibration.json`` times the fit's
   *answer cost*, the cost (weighted mm, Eq. 17: the search's pixel cost) of its answer
   (the mean of the answers a fit averaged, for the population searches). The factors are
-  such that on the accuracy benchmark's out-of-space subjects (full Anny bodies
-  photographed through a phone camera: the benchmark's stand-in for real people) the
-  truth lay within the ± for 68.3 % of the subjects, each measurement (one standard
-  deviation's share of a normal error); they come from ``python -m bench.accuracy
-  spread`` on the default's held-out out-of-space fits (docs/accuracy.md, "The
-  protocol"; the calibration file names its command). The cost scales the ± because a
+  such that on the accuracy benchmark's people as they stand (full Anny bodies posed by
+  their own skeleton, photographed through a hand-held phone: the benchmark's stand-in
+  for real people) the truth lay within the ± for 68.3 % of the subjects, each
+  measurement (one standard deviation's share of a normal error); they come from
+  ``python -m bench.accuracy spread`` on the default's fits of the standing set's choice
+  rows (docs/accuracy.md, "People as they stand"; the calibration file names its
+  command). The cost scales the ± because a
   body the model's space cannot reproduce leaves its silhouettes matched worse: the
   in-space subjects' answer costs are smaller than the out-of-space ones', their errors
   smaller still. Real photos (clothes, hair, a segmentation less clean than the
@@ -51,8 +52,8 @@ __all__ = ["SPREAD_BASES", "SPREAD_NOTES", "CALIBRATION_FILE", "CALIBRATION_FORM
 SPREAD_BASES = ("calibrated", "solver", "population")
 #: What each kind of ± means, in a sentence for the report and the command line.
 SPREAD_NOTES = {
-    "calibrated": "the ± held the truth for 68 % of the accuracy benchmark's out-of-space "
-                  "subjects (synthetic photos), scaled by how well this fit matched the "
+    "calibrated": "the ± held the truth for 68 % of the accuracy benchmark's people as "
+                  "they stand (synthetic photos), scaled by how well this fit matched the "
                   "silhouettes; real photos may err more",
     "solver": "the ± is the default method's calibration applied to this fit's cost; "
               "for these settings it is not checked against the truth",
