@@ -29,7 +29,7 @@ from threadpoolctl import threadpool_limits
 from bodyfit.fitter.fit import person_fit
 from bodyfit.fitter.fit.canvas import extreme_bodies
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
-from bodyfit.fitter.fit.pitch import PITCH_ITERATIONS, PITCH_STEP_DEG
+from bodyfit.fitter.fit.pitch import PITCH_ITERATIONS, PITCH_STEP_DEG, searched_pitches
 from bodyfit.fitter.measure.measurements import IMPORTANT, Measurer
 from bodyfit.fitter.model.cache import load_model
 
@@ -88,17 +88,19 @@ def _important(point: dict) -> float:
 
 
 def _chosen(record: dict, rule: str, prior: float) -> dict:
-    """The grid point ``rule`` chooses by cost + prior * (sum of squared pitches)."""
+    """The grid point ``rule`` chooses by cost + prior * (sum of squared pitches): the
+    default's (:func:`searched_pitches` over the grid's solves), or the best of the whole
+    grid, of the side camera's pitches alone or of the front camera's."""
     points = {(p["front"], p["side"]): p for p in record["grid"]}
-    score = {key: p["cost"] + prior * (key[0] ** 2 + key[1] ** 2) for key, p in points.items()}
     if rule == "default":
-        best = tuple(min(STEPS, key=lambda step: score[(step, 0.0) if i == 0 else (0.0, step)])
-                     for i in range(2))
-        tried = [(0.0, 0.0)] + [(s, 0.0) for s in STEPS if s] + [(0.0, s) for s in STEPS if s]
-        keys = tried + ([best] if all(best) else [])
-    else:
-        keys = [key for key in points if rule == "grid" or
-                (rule == "side" and key[0] == 0.0) or (rule == "front" and key[1] == 0.0)]
+        def solved(pitches, start):
+            point = points[(pitches["front"], pitches["side"])]
+            return point["cost"], point
+        return searched_pitches(solved, (points[(0.0, 0.0)]["cost"], points[(0.0, 0.0)]),
+                                prior=prior)[0]
+    score = {key: p["cost"] + prior * (key[0] ** 2 + key[1] ** 2) for key, p in points.items()}
+    keys = [key for key in points if rule == "grid" or
+            (rule == "side" and key[0] == 0.0) or (rule == "front" and key[1] == 0.0)]
     return points[min(keys, key=score.get)]
 
 

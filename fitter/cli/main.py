@@ -16,6 +16,7 @@ from pathlib import Path
 from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
+from bodyfit.fitter.fit.pitch import PITCHES, pitch_text
 
 __all__ = ["main"]
 
@@ -132,7 +133,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="the local solver's elbows: fitted (the default: one flexion "
                              "for both arms and photos, solved with the body) or rest (the "
                              "model's rest pose's, about 43 degrees)")
-    parser.add_argument("--pitch", choices=("searched", "level"),  # pitch.PITCHES
+    parser.add_argument("--pitch", choices=PITCHES,
                         help="the cameras' pitch: searched (the default: the local solver "
                              "run again with each camera pitched 4 degrees down and up, the "
                              "best-scored answer kept; about twice the time) or level (both "
@@ -391,7 +392,6 @@ def _cmd_demo(args) -> None:
 
 def _photos_line(fit) -> str:
     """What was read of the photos besides the silhouettes, for the summary."""
-    from bodyfit.fitter.fit.pitch import pitch_text
     pitch = fit.photos.get("pitch_deg")
     return (f"  camera: {fit.photos['camera']}; the side photo shows the person's "
             f"{fit.photos['side_from']} side"

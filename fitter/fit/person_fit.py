@@ -506,8 +506,7 @@ def _pitch_searched(model, views, masks, intrinsics, stature_m, sex: str,
     def solve_at(pitches: dict[str, float], start):
         tried = dict(views)
         result = _solved(model, tried, masks, intrinsics, stature_m, sex, short, None,
-                         canvas_bodies, start[0],
-                         {name: pitches.get(name, 0.0) for name in views})
+                         canvas_bodies, start[0], pitches)
         evaluations.append(result.evaluations)
         return result.cost, (result, tried)
 

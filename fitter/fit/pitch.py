@@ -82,6 +82,7 @@ def searched_pitches(solve_at: Callable[[dict[str, float], Answer], tuple[float,
     _, answer, pitches = min(tried, key=lambda entry: entry[0])
     return answer, pitches
 
+
 def pitch_text(pitches: dict[str, float]) -> str:
     """The cameras' pitch in words, for the summary and the report (view name -> degrees,
     positive looking down)."""
