@@ -23,13 +23,20 @@ from bodyfit.fitter.measure.measurements import Measurer
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel
 from bodyfit.fitter.run.config import run_config
 
-__all__ = ["FitPhotos", "answer_pose"]
+__all__ = ["FitPhotos", "answer_pose", "recorded_twist"]
 
 
 def answer_pose(record: dict) -> np.ndarray:
     """(4,) degrees: the fit's answered angles, in ``POSE_NAMES`` order, of run.json's
     payload ``record``."""
     return np.array([record["result"]["pose_deg"][name] for name in POSE_NAMES])
+
+
+def recorded_twist(record: dict) -> np.ndarray | None:
+    """(2,) degrees: the front photo's left and right hands' twists the fit answered with,
+    of run.json's payload ``record``; None: the rest pose's (fits before them too)."""
+    twist = record["result"].get("hand_twist_deg")
+    return None if twist is None else np.array([twist["left"], twist["right"]])
 
 
 @dataclasses.dataclass(frozen=True)
@@ -43,6 +50,8 @@ class FitPhotos:
         views: view name -> the view its fit started on (its parts and pose are read).
         stature_m: the person's stature, metres.
         flexion_deg: the elbows' flexion the fit answered with (None: the rest pose's).
+        twist_deg: (2,) the front photo's hands' twists it answered with (None: the rest
+            pose's).
     """
 
     settings: FitSettings
@@ -51,6 +60,7 @@ class FitPhotos:
     views: dict[str, kernels.ViewTarget]
     stature_m: float
     flexion_deg: float | None
+    twist_deg: np.ndarray | None
 
     @classmethod
     def of(cls, model: BodyModel, set_folder: Path, subject: str, record: dict) -> "FitPhotos":
@@ -73,18 +83,18 @@ class FitPhotos:
                              extreme_bodies(model, s.components, s.pose_lower_deg,
                                             s.pose_upper_deg, settings.canvas.beta_limit))
         return cls(settings, masks, intrinsics, views, stature_m,
-                   record["result"].get("elbow_deg"))
+                   record["result"].get("elbow_deg"), recorded_twist(record))
 
     def measure(self, model: BodyModel, measurer: Measurer, betas: np.ndarray,
                 pose_deg: np.ndarray
                 ) -> tuple[np.ndarray, dict[str, float], dict[str, ViewPhoto] | None]:
         """(rest (V, 3) metres, key -> mm, the view photos or None) of a body of the fit's
         search (betas (K,), the first solved to the stature when the search conditions it;
-        pose (4,) degrees; the elbows as the fit answered), measured as `fitter run`
+        pose (4,) degrees; the elbows and hands as the fit answered), measured as `fitter run`
         measures its answer."""
         _, rest, view_bodies = fitted_bodies(model, betas, pose_deg, self.views, self.stature_m,
                                              self.settings.search.condition_stature,
-                                             self.flexion_deg)
+                                             self.flexion_deg, self.twist_deg)
         values = fitted_measurements(model, measurer, self.settings, rest, view_bodies,
                                      self.views, self.masks, self.intrinsics)
         return rest, values, view_photos(self.settings, self.views, view_bodies, self.masks,

@@ -64,7 +64,7 @@ def subject_grid(model, measurer, set_folder: Path, row: dict) -> dict:
     def errors(result, solved_views) -> dict:
         _, rest, view_bodies = person_fit.fitted_bodies(
             model, result.betas, result.pose_deg, solved_views, stature, True,
-            result.elbow_deg)
+            result.elbow_deg, result.hand_twist_deg)
         fitted = person_fit.fitted_measurements(model, measurer, settings, rest, view_bodies,
                                                 solved_views, masks, intrinsics)
         return {k: float(fitted[k] - truth["measurements"][k]) for k in fitted}

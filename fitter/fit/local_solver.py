@@ -50,7 +50,7 @@ import scipy.ndimage as ndi
 from scipy.spatial import cKDTree
 
 from bodyfit.common.errors import UserError
-from bodyfit.fitter.fit.elbows import elbow_forward, elbow_rig
+from bodyfit.fitter.fit.elbows import elbow_forward, elbow_rig, view_twist
 from bodyfit.fitter.fit.outline import OutlineSamples, ViewOutline, moved_camera
 from bodyfit.fitter.fit.pitch import PITCHES
 from bodyfit.fitter.model.body_model import BodyModel
@@ -70,10 +70,18 @@ SOLVER_STARTS = ("mean", "learned")
 ELBOWS = ("fitted", "rest")
 #: The bounds of a fitted elbow flexion, degrees.
 ELBOW_RANGE_DEG = (0.0, 60.0)
+#: How the solver treats the hands in the front photo: ``"fitted"``, each hand's twist
+#: about its forearm solved with the body (:mod:`bodyfit.fitter.fit.elbows`);
+#: ``"rest"``, the rest pose's (palms facing in).
+HANDS = ("fitted", "rest")
+#: The bounds of a fitted hand's twist, degrees (0: palm in, 90: palm forward), and
+#: where it starts: the middle of the turns people stand with.
+TWIST_RANGE_DEG = (-15.0, 120.0)
+TWIST_START_DEG = 45.0
 #: How far (metres, each axis) the solver may move a view's camera from where it was placed.
 _CAMERA_REACH_M = 0.5
 
-__all__ = ["SOLVER_STARTS", "ELBOWS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
+__all__ = ["SOLVER_STARTS", "ELBOWS", "HANDS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
            "signed_distance", "sample_bilinear", "LocalProblem", "solve", "placement_iterations",
            "moved_view"]
 
@@ -104,6 +112,8 @@ class SolverSettings:
             off the silhouettes (:mod:`bodyfit.fitter.fit.learned_start`; with 0
             iterations, that body is the answer).
         elbows: one of ``ELBOWS``; a fitted flexion starts at the rest pose's.
+        hands: one of ``HANDS``; fitted twists start at ``TWIST_START_DEG`` (or at an
+            earlier solve's).
         pitch: the pinhole cameras' pitch, one of ``pitch.PITCHES``: ``"searched"``, the
             solver run again with each view's camera pitched
             (:mod:`bodyfit.fitter.fit.pitch`), or ``"level"``.
@@ -120,6 +130,7 @@ class SolverSettings:
     tolerance: float = 1e-5
     start: str = "mean"
     elbows: str = "rest"
+    hands: str = "rest"
     pitch: str = "level"
 
     def validate(self, stored_components: int) -> None:
@@ -139,6 +150,8 @@ class SolverSettings:
                             f"got {self.start!r}")
         if self.elbows not in ELBOWS:
             raise UserError(f"--elbows must be one of {', '.join(ELBOWS)}, got {self.elbows!r}")
+        if self.hands not in HANDS:
+            raise UserError(f"--hands must be one of {', '.join(HANDS)}, got {self.hands!r}")
         if self.pitch not in PITCHES:
             raise UserError(f"--pitch must be one of {', '.join(PITCHES)}, got {self.pitch!r}")
 
@@ -235,8 +248,9 @@ class Residuals:
 
 class LocalProblem:
     """One person's smooth cost (the module docstring) over the genes (betas 2..K, the
-    four angles), the elbows' flexion when ``settings.elbows`` fits it, and a camera move
-    per view, in that order.
+    four angles), the elbows' flexion when ``settings.elbows`` fits it, the front
+    photo's hands' twists (left, right) when ``settings.hands`` fits them, and a camera
+    move per view, in that order.
 
     Args:
         model: the render model (:func:`~bodyfit.fitter.fit.render_mesh.render_model`).
@@ -265,21 +279,28 @@ class LocalProblem:
         self.names = list(views)
         self.num_genes = self.k - 1 + 4
         self.rig = elbow_rig(model) if settings.elbows == "fitted" else None
-        #: where the cameras' moves start in the parameters (after the elbows, if fitted)
-        self.camera_start = self.num_genes + (self.rig is not None)
-        elbow = [ELBOW_RANGE_DEG] if self.rig is not None else np.zeros((0, 2))
+        self.fits_twist = settings.hands == "fitted"
+        #: where the cameras' moves start in the parameters (after the elbows and the
+        #: hands, if fitted)
+        self.camera_start = self.num_genes + (self.rig is not None) + 2 * self.fits_twist
+        turns = np.array([ELBOW_RANGE_DEG] * (self.rig is not None)
+                         + [TWIST_RANGE_DEG] * 2 * self.fits_twist).reshape(-1, 2)
         self.lower = np.r_[np.full(self.k - 1, -beta_limit), pose_lower_deg,
-                           np.array(elbow)[:, 0], np.full(3 * len(views), -_CAMERA_REACH_M)]
+                           turns[:, 0], np.full(3 * len(views), -_CAMERA_REACH_M)]
         self.upper = np.r_[np.full(self.k - 1, beta_limit), pose_upper_deg,
-                           np.array(elbow)[:, 1], np.full(3 * len(views), _CAMERA_REACH_M)]
+                           turns[:, 1], np.full(3 * len(views), _CAMERA_REACH_M)]
 
-    def start(self, genes: np.ndarray, flexion_deg: float | None = None) -> np.ndarray:
+    def start(self, genes: np.ndarray, flexion_deg: float | None = None,
+              twist_deg: np.ndarray | None = None) -> np.ndarray:
         """The parameters of ``genes`` (K - 1 + 4,): the elbows at ``flexion_deg`` (None:
-        the rest pose's), the cameras where they stand."""
+        the rest pose's), the hands at ``twist_deg`` ((2,); None: ``TWIST_START_DEG``),
+        the cameras where they stand."""
         elbow = ([self.rig.rest_deg if flexion_deg is None else flexion_deg]
                  if self.rig is not None else [])
-        return np.clip(np.r_[genes, elbow, np.zeros(3 * len(self.names))], self.lower,
-                       self.upper)
+        twist = (np.broadcast_to(TWIST_START_DEG if twist_deg is None else twist_deg, 2)
+                 if self.fits_twist else [])
+        return np.clip(np.r_[genes, elbow, twist, np.zeros(3 * len(self.names))],
+                       self.lower, self.upper)
 
     def camera_moves(self, x: np.ndarray) -> dict[str, np.ndarray]:
         """View name -> (3,) metres, the move of its camera in the parameters ``x``."""
@@ -290,13 +311,16 @@ class LocalProblem:
         """Score against ``view`` (the view of its name with its camera placed anew)."""
         self.outlines[view.name].view = view
 
-    def body(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float | None]:
-        """(betas (K,), pose (4,) degrees, the elbows' flexion in degrees or None for the
-        rest pose's) of the parameters ``x``."""
+    def body(self, x: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, float | None, np.ndarray | None]:
+        """(betas (K,), pose (4,) degrees, the elbows' flexion and the front photo's
+        hands' twists (2,) in degrees, each None for the rest pose's) of the parameters
+        ``x``."""
         genes = x[:self.num_genes]
         betas = self.conditioner.complete(genes[None, :self.k - 1], genes[None, self.k - 1:])[0]
-        return betas, genes[self.k - 1:], (float(x[self.num_genes]) if self.rig is not None
-                                            else None)
+        flexion = float(x[self.num_genes]) if self.rig is not None else None
+        twist = x[self.camera_start - 2:self.camera_start].copy() if self.fits_twist else None
+        return betas, genes[self.k - 1:], flexion, twist
 
     def _first_beta_slope(self, x: np.ndarray) -> np.ndarray:
         """(K - 1,) d first beta / d betas 2..K (the stature held), by differences (the
@@ -311,13 +335,14 @@ class LocalProblem:
     def residuals(self, x: np.ndarray) -> "Residuals":
         """The residuals of the parameters ``x`` over every view's outline samples (one
         render a view), with what :meth:`jacobian` needs of them."""
-        betas, pose, flexion = self.body(x)
+        betas, pose, flexion, twist = self.body(x)
         weights, distances, readings = [], [], []
         share = 1.0 - self.settings.person_to_model
         for name, move in self.camera_moves(x).items():
             outline = self.outlines[name]
             view = outline.view
-            posed = elbow_forward(self.model, betas[None], view.view_pose(pose[None]), flexion)[0]
+            posed = elbow_forward(self.model, betas[None], view.view_pose(pose[None]), flexion,
+                                  view_twist(name, twist))[0]
             camera = moved_camera(view.camera, move)
             samples = outline.samples(posed.astype(np.float64), camera)
             mm, view_weight = view.millimetres_per_pixel, self.view_weights[name]
@@ -342,17 +367,22 @@ class LocalProblem:
     def jacobian(self, x: np.ndarray, residuals: "Residuals") -> np.ndarray:
         """(S, len(x)) d distances (mm) / d ``x`` of ``residuals`` (:meth:`residuals` of
         ``x``), rows in their order; no render."""
-        betas, pose, flexion = self.body(x)
+        betas, pose, flexion, twist = self.body(x)
         slope = self._first_beta_slope(x)
         rows = []
         for i, (name, reading) in enumerate(zip(self.names, residuals.readings)):
             outline = self.outlines[name]
             mm = outline.view.millimetres_per_pixel
             first = self.camera_start + 3 * i
-            d_pixels = outline.jacobian(reading.samples, betas, pose, reading.camera, flexion)
+            seen_twist = view_twist(name, twist)
+            d_pixels = outline.jacobian(reading.samples, betas, pose, reading.camera, flexion,
+                                        seen_twist)
             d_points = np.zeros((len(reading.samples.points), 2, len(x)))
-            # columns of d_pixels: K betas, 4 angles, the flexion if fitted, 3 camera
-            d_points[:, :, :self.camera_start] = np.concatenate(
+            # columns of d_pixels: K betas, 4 angles, the flexion if fitted, the twists if
+            # fitted and this view's hands turn with them, 3 camera (a view's hands that do
+            # not turn: the twists' columns stay zero)
+            turns = self.camera_start - 2 * (self.fits_twist and seen_twist is None)
+            d_points[:, :, :turns] = np.concatenate(
                 [d_pixels[:, :, 1:self.k] + d_pixels[:, :, :1] * slope[None, None],
                  d_pixels[:, :, self.k:-3]], axis=2)
             d_points[:, :, first:first + 3] = d_pixels[:, :, -3:]
@@ -374,22 +404,24 @@ class LocalProblem:
 
 
 def solve(problem: LocalProblem, start: np.ndarray, place=None,
-          flexion_deg: float | None = None) -> tuple[np.ndarray, SolverTrace]:
+          flexion_deg: float | None = None, twist_deg: np.ndarray | None = None
+          ) -> tuple[np.ndarray, SolverTrace]:
     """Levenberg-Marquardt from ``start`` (genes (K - 1 + 4,); the cameras where they stand).
 
     Args:
         problem: the person's cost.
         start: the genes to start from.
         flexion_deg: the fitted elbows' flexion to start from (None: the rest pose's).
+        twist_deg: the fitted hands' twists (2,) to start from (None: ``TWIST_START_DEG``).
         place: None, or called with :meth:`LocalProblem.body`'s (betas (K,), pose (4,),
-            flexion) to place the cameras anew (it calls ``problem.replace_view``),
+            flexion, twist) to place the cameras anew (it calls ``problem.replace_view``),
             ``settings.placements`` times.
 
     Returns:
         (the solved parameters (:class:`LocalProblem`'s order), the trace).
     """
     s = problem.settings
-    x = problem.start(start, flexion_deg)
+    x = problem.start(start, flexion_deg, twist_deg)
     trace = SolverTrace()
     at = placement_iterations(s)
     damping = 1e-3

@@ -36,7 +36,7 @@ import warp as wp
 from scipy.spatial import cKDTree
 
 from bodyfit import kernels
-from bodyfit.fitter.fit.elbows import bend_derivative, bent, elbow_rig
+from bodyfit.fitter.fit.elbows import bend_derivative, bent, elbow_rig, wrist_rig
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, rest_shape
 from bodyfit.kernels.body_forward import abduction_rotations, blend_skinning
 from bodyfit.kernels.body_layout import POSE_SIDES
@@ -144,8 +144,8 @@ def moved_camera(camera: kernels.ViewCamera, translation_m: np.ndarray) -> kerne
 
 
 def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
-                        vertices: np.ndarray, flexion_deg: float | None = None
-                        ) -> tuple[np.ndarray, np.ndarray]:
+                        vertices: np.ndarray, flexion_deg: float | None = None,
+                        twist_deg: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Posed vertices of one body and their derivatives, float64.
 
     Args:
@@ -155,27 +155,41 @@ def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarra
         vertices: (N,) int, the vertices wanted.
         flexion_deg: both elbows bent to this before the skinning
             (:mod:`bodyfit.fitter.fit.elbows`), or None (the rest pose's).
+        twist_deg: (2,) the left and right hands turned by these before the elbows'
+            bend, or None (the rest pose's).
 
     Returns:
         posed: (N, 3) metres.
-        jacobian: (N, 3, K + 4 (+ 1)): d posed / d (betas, then the four angles, then
-            the flexion when given), metres per standard deviation and per degree. For a
-            fixed pose the posed vertices are linear in the betas (the skinning applied to
-            the shape directions); each chain's angle turns its share of the vertex about
-            its joint; the flexion turns the forearms before.
+        jacobian: (N, 3, K + 4 (+ 1) (+ 2)): d posed / d (betas, then the four angles,
+            then the flexion when given, then the two twists when given), metres per standard
+            deviation and per degree. For a fixed pose the posed vertices are linear in
+            the betas (the skinning applied to the shape directions); each chain's angle
+            turns its share of the vertex about its joint; the flexion turns the forearms
+            before, and the twist the hands before that.
     """
     k = len(betas)
     rest, joints = rest_shape(model, np.asarray(betas)[None])
+    rest = rest[0].astype(np.float64)
     joints = joints[0].astype(np.float64)
     vertex_dirs, joint_dirs = model.shape_directions(k)
+    turned = []  # d rest / d (flexion, twists), as given: (N, 3) each
+    if twist_deg is not None:  # the whole bodies turned: the elbow rings' centroids whole
+        hands = wrist_rig(model)
+        d_twist = [bend_derivative(hands, rest, twist_deg, side=side) for side in (0, 1)]
+        rest = bent(hands, rest, twist_deg)
+        vertex_dirs = bent(hands, vertex_dirs, twist_deg)
     if flexion_deg is None:
-        rest = rest[0, vertices].astype(np.float64)
+        rest = rest[vertices]
         dirs = vertex_dirs[:, vertices].astype(np.float64)
     else:
         rig = elbow_rig(model)  # only the wanted vertices bent (the rings' centroids whole)
-        d_flexion = bend_derivative(rig, rest[0], flexion_deg, vertices)
-        rest = bent(rig, rest[0], flexion_deg, vertices)
+        turned.append(bend_derivative(rig, rest, flexion_deg, vertices))
+        if twist_deg is not None:  # the bend is linear: it maps the twists' motions too
+            d_twist = [bent(rig, d, flexion_deg) for d in d_twist]
+        rest = bent(rig, rest, flexion_deg, vertices)
         dirs = bent(rig, vertex_dirs, flexion_deg, vertices)
+    if twist_deg is not None:
+        turned += [d[vertices] for d in d_twist]
     dirs = dirs.transpose(1, 2, 0)  # (N, 3, K)
     rotations = abduction_rotations(np.asarray(pose_deg, np.float64)[None])[0]  # (4, 3, 3)
     weights = model.chain_weights[vertices].astype(np.float64)  # (N, 4)
@@ -195,10 +209,10 @@ def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarra
             * POSE_SIDES[c] * np.pi / 180.0
         d_angles[:, :, c] = weights[:, c, None] * ((rest - joints[c]) @ d_rot.T)
     columns = [d_betas, d_angles]
-    if flexion_deg is not None:  # the skinning is linear in the rest body, joints held
-        skinned = d_flexion * (1.0 - weights.sum(axis=1))[:, None]
+    for d_rest in turned:  # the skinning is linear in the rest body, joints held
+        skinned = d_rest * (1.0 - weights.sum(axis=1))[:, None]
         for c in range(len(POSE_NAMES)):
-            skinned += weights[:, c, None] * (d_flexion @ rotations[c].T)
+            skinned += weights[:, c, None] * (d_rest @ rotations[c].T)
         columns.append(skinned[:, :, None])
     return posed.astype(np.float64), np.concatenate(columns, axis=2)
 
@@ -295,16 +309,17 @@ class ViewOutline:
         return row, col
 
     def jacobian(self, samples: OutlineSamples, betas: np.ndarray, pose_deg: np.ndarray,
-                 camera: kernels.ViewCamera, flexion_deg: float | None = None) -> np.ndarray:
-        """(S, 2, K + 4 (+ 1) + 3) d sample pixels / d (betas, the four angles, the
-        elbows' flexion when given, the camera's translation) of a body (betas (K,), its
-        own pose (4,) degrees, its elbows' flexion or None) seen by ``camera``: the view's
-        fixed angles (the side view's arms) do not move with the body's, so their columns
-        are zero."""
+                 camera: kernels.ViewCamera, flexion_deg: float | None = None,
+                 twist_deg: np.ndarray | None = None) -> np.ndarray:
+        """(S, 2, K + 4 (+ 1) (+ 2) + 3) d sample pixels / d (betas, the four angles, the
+        elbows' flexion when given, the hands' twists when given, the camera's
+        translation) of a body (betas (K,), its own pose (4,) degrees, its elbows' flexion
+        and hands' twist or None) seen by ``camera``: the view's fixed angles (the side
+        view's arms) do not move with the body's, so their columns are zero."""
         view_pose = self.view.view_pose(np.asarray(pose_deg, np.float64)[None])[0]
         wanted, index = np.unique(samples.edges.ravel(), return_inverse=True)
         posed, d_posed = posed_with_jacobian(self.model, betas, view_pose, wanted,
-                                             flexion_deg)
+                                             flexion_deg, twist_deg)
         _, d_camera = project_with_jacobian(camera, posed)
         rotation = camera_matrices(camera)[1]
         d = np.concatenate([np.einsum("nij,njk->nik", d_camera @ rotation, d_posed), d_camera],

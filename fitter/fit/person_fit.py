@@ -17,7 +17,7 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
                                        orthographic_view)
-from bodyfit.fitter.fit.elbows import elbow_forward
+from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
 from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
@@ -85,6 +85,7 @@ class FitSettings:
     search: SearchSettings = SearchSettings(searches=0, refine_components=0,
                                             pose_lower_deg=ARMS_LOWER_DEG)
     solver: SolverSettings = SolverSettings(iterations=40, start="learned", elbows="fitted",
+                                            hands="fitted",
                                             placements_within=10, pitch="searched")
     canvas: CanvasSettings = CanvasSettings()
     cost: kernels.CostSettings = cost_settings(
@@ -259,11 +260,13 @@ def _scoring(model: BodyModel, views: dict[str, kernels.ViewTarget], settings: F
 
 def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                    view: kernels.ViewTarget, stature_m: float,
-                   condition_stature: bool, flexion_deg: float | None = None) -> np.ndarray:
+                   condition_stature: bool, flexion_deg: float | None = None,
+                   twist_deg: float | None = None) -> np.ndarray:
     """(V', 3) float64 metres: the body a pinhole view's camera is placed from
     (:func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
-    (4,) degrees, its elbows' flexion or None for the rest pose's): the parts the view
-    shows, in the view's pose, as the kernels (or the local solver) render it.
+    (4,) degrees, its elbows' flexion and front hands' twist, each None for the rest
+    pose's): the parts the view shows, in the view's pose, as the kernels (or the local
+    solver) render it.
 
     A candidate conditioned on the stature (:mod:`bodyfit.fitter.fit.stature`) is taken as it
     is: on the rest stature (pinhole views) it is the person's size. (Conditioned on the
@@ -275,7 +278,8 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     conditioning a candidate has its own height, and the camera is placed for it scaled to
     the person's stature.
     """
-    body = elbow_forward(model, betas[None], view.view_pose(pose_deg[None]), flexion_deg)[0]
+    body = elbow_forward(model, betas[None], view.view_pose(pose_deg[None]), flexion_deg,
+                         view_twist(view.name, twist_deg))[0]
     if not condition_stature:
         body = body * stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
     shown = visible_vertices(model.vertex_parts, view.visible_parts)
@@ -284,15 +288,17 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
 
 def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
                   betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None = None,
+                  twist_deg: float | None = None,
                   pitches: dict[str, float] | None = None) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
-    degrees, elbows' flexion or None) as it is rendered (:func:`placement_body`,
+    degrees, elbows' flexion and hands' twist or None) as it is rendered
+    (:func:`placement_body`,
     :func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`), pitched by ``pitches`` (view
     name -> degrees; None: each camera keeps its pitch); updates ``views`` and the
     evaluator."""
     for name, view in views.items():
         body = placement_body(model, betas, pose_deg, view, stature_m,
-                              settings.search.condition_stature, flexion_deg)
+                              settings.search.condition_stature, flexion_deg, twist_deg)
         views[name] = placed_anew(view, masks[name], intrinsics[name], body,
                                   None if pitches is None else pitches[name])
         evaluator.replace_view(views[name])
@@ -454,26 +460,29 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
                         problem.lower[:problem.num_genes], problem.upper[:problem.num_genes])
 
     def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None,
-              turned: dict[str, float] | None = None) -> None:
+              twist_deg: float | None, turned: dict[str, float] | None = None) -> None:
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
-                      pose_deg, flexion_deg, turned)
+                      pose_deg, flexion_deg, twist_deg, turned)
         for view in views.values():
             problem.replace_view(view)
 
     pinhole = settings.projection == "pinhole"
     start_flexion = None if warm is None else warm.elbow_deg
+    start_twist = None if warm is None else warm.hand_twist_deg
     if (warm is not None or settings.learned_start) and pinhole:  # placed for the start
-        place(*problem.body(problem.start(start, start_flexion)), pitches)
-    solved, trace = solve(problem, start, place if pinhole else None, start_flexion)
-    betas, pose, flexion = problem.body(solved)
+        place(*problem.body(problem.start(start, start_flexion, start_twist)), pitches)
+    solved, trace = solve(problem, start, place if pinhole else None, start_flexion,
+                          start_twist)
+    betas, pose, flexion, twist = problem.body(solved)
     for name, move in problem.camera_moves(solved).items():
         views[name] = moved_view(views[name], move)
         evaluator.replace_view(views[name])
-    if flexion is None:
+    if flexion is None and twist is None:
         scored = evaluator.evaluate(betas[None], pose[None])
-    else:  # the kernels' rig has no elbows: the bodies as the solver posed them
+    else:  # the kernels' rig has no elbows or hands: the bodies as the solver posed them
         scored = evaluator.evaluate_posed({
-            name: elbow_forward(problem.model, betas[None], view.view_pose(pose[None]), flexion)
+            name: elbow_forward(problem.model, betas[None], view.view_pose(pose[None]), flexion,
+                                view_twist(name, twist))
             for name, view in views.items()})
     genes = np.array(trace.genes) if trace.genes else start[None]
     # the solver's cost per iteration; with none (the learned start alone), the start's
@@ -488,7 +497,7 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         final_genes=np.r_[betas, pose][None], final_costs=scored.costs[:1].astype(np.float64),
         evaluations=trace.evaluations, generations=len(trace.costs),
         seconds=time.perf_counter() - began, stop_reasons={"solver": trace.stop_reason},
-        elbow_deg=flexion)
+        elbow_deg=flexion, hand_twist_deg=twist)
     return result if first is None else refined(first, result)
 
 
@@ -517,16 +526,17 @@ def _pitch_searched(model, views, masks, intrinsics, stature_m, sex: str,
 
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                   views: dict[str, kernels.ViewTarget], stature_m: float,
-                  condition_stature: bool, flexion_deg: float | None = None
-                  ) -> tuple[np.ndarray, np.ndarray, dict]:
-    """The fit's bodies of its answer (betas (K,), pose (4,) degrees, elbows' flexion or
-    None for the rest pose's; the rest body keeps the rest pose's), float32 metres:
+                  condition_stature: bool, flexion_deg: float | None = None,
+                  twist_deg: float | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The fit's bodies of its answer (betas (K,), pose (4,) degrees, elbows' flexion and
+    the front photo's hands' twist, each None for the rest pose's; the posed body has the
+    front photo's hands, the rest body the rest pose's), float32 metres:
     (posed (V, 3), rest (V, 3), view name -> (V, 3) in that view's pose), the posed and
     rest bodies rescaled to the stature when the search conditioned it (a posed height
     conditioned, or a first beta at its limit), the view bodies as the search scored them."""
-    posed = elbow_forward(model, betas[None], pose_deg[None], flexion_deg)[0]
+    posed = elbow_forward(model, betas[None], pose_deg[None], flexion_deg, twist_deg)[0]
     view_bodies = {name: elbow_forward(model, betas[None], view.view_pose(pose_deg[None]),
-                                       flexion_deg)[0]
+                                       flexion_deg, view_twist(name, twist_deg))[0]
                    for name, view in views.items()}
     rest = rest_shape(model, betas[None])[0][0]
     if condition_stature:
@@ -609,7 +619,7 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     t2 = time.perf_counter()
     posed, rest, view_bodies = fitted_bodies(model, result.betas, result.pose_deg, views,
                                              stature_m, s.condition_stature,
-                                             result.elbow_deg)
+                                             result.elbow_deg, result.hand_twist_deg)
     measurer = Measurer.from_model(model)
     measurements = fitted_measurements(model, measurer, settings, rest, view_bodies, views,
                                        masks, intrinsics)

@@ -173,6 +173,9 @@ class SearchResult:
             (:func:`averaged`; after :func:`refined`, the refinements'); () for one search.
         elbow_deg: the elbows' flexion of the answer, degrees (the local solver's
             ``elbows="fitted"``); None: the rest pose's.
+        hand_twist_deg: (2,) the front photo's left and right hands' twists of the answer,
+            degrees (the local solver's ``hands="fitted"``; 0 palm in, 90 palm forward);
+            None: the rest pose's.
     """
 
     betas: np.ndarray
@@ -190,6 +193,7 @@ class SearchResult:
     stop_reasons: dict
     averaged_from: tuple["SearchResult", ...] = ()
     elbow_deg: float | None = None
+    hand_twist_deg: np.ndarray | None = None
 
 
 class _Search:

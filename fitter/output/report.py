@@ -85,12 +85,15 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
     result = record["result"]
     default = "the optimiser's default"
     learned = solver.get("start") == "learned"
-    elbows = result.get("elbow_deg")
+    elbows, hands = result.get("elbow_deg"), result.get("hand_twist_deg")
     solver_row = ("local solver", f"{_e(solver['iterations'])} iterations at most, "
                                   f"{_e(solver['components'])} components"
                                   + (", from the learned start" if learned else "")
                                   + ("" if elbows is None else
                                      f"; the elbows fitted, {elbows:.1f} degrees")
+                                  + ("" if hands is None else
+                                     "; the front photo's hands turned {} and {} degrees "
+                                     "from palm in".format(*map(round, hands.values())))
                   if solver["iterations"] else
                   "none: the learned start's body" if learned else "none")
     if not search["searches"]:

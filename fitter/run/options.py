@@ -53,7 +53,7 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     the weights) and ``weight`` (a list of ``NAME=VALUE`` overrides on top)), ``device``,
     ``threads``, ``side_arms``, ``projection``, ``placement_rounds``, ``arms_lower_deg``
     (both shoulders' lowest abduction) and the local solver's
-    ``iterations``, ``start``, ``elbows``, ``placements_within`` and ``pitch``.
+    ``iterations``, ``start``, ``elbows``, ``hands``, ``placements_within`` and ``pitch``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -78,7 +78,7 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
         record = weights_record(cost) | dict(map(parse_override, given["weight"]))
         cost = settings_from_record(record, cost)
     solver = dataclasses.replace(base.solver, **{k: given[k] for k in
-                                                 ("iterations", "start", "elbows",
+                                                 ("iterations", "start", "elbows", "hands",
                                                   "placements_within", "pitch")
                                                  if k in given})
     return dataclasses.replace(base, search=search, solver=solver, cost=cost,

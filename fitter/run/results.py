@@ -87,6 +87,8 @@ def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fi
             "betas": result.betas.tolist(),
             "pose_deg": dict(zip(POSE_NAMES, result.pose_deg.tolist())),
             "elbow_deg": result.elbow_deg,
+            "hand_twist_deg": (None if result.hand_twist_deg is None
+                               else dict(zip(("left", "right"), result.hand_twist_deg.tolist()))),
             "evaluations": result.evaluations,
             "generations": result.generations,
             "stop_reasons": {k: str(v) for k, v in result.stop_reasons.items()},

@@ -65,6 +65,9 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     assert record["settings"]["solver"]["iterations"] == 40
     assert record["settings"]["solver"]["start"] == "learned"
     assert record["settings"]["solver"]["pitch"] == "searched"
+    assert record["settings"]["solver"]["hands"] == "fitted"  # the demo's are the rest
+    twists = record["result"]["hand_twist_deg"]  # pose's, palms in (measured: -0.1, -0.0)
+    assert set(twists) == {"left", "right"} and max(map(abs, twists.values())) < 5.0
     assert set(record["photos"]["pitch_deg"].values()) <= {-4.0, 0.0, 4.0}
     assert len(record["result"]["betas"]) == 40
     assert record["inputs"]["camera"] == "demo/camera.json"
