@@ -32,8 +32,9 @@ from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
 from bodyfit.fitter.output.plots import line_chart
 
 #: name -> `fitter run` options: bodyfit's default (the local solver from the learned
-#: start, 40 iterations at most, the cameras' pitch searched), the same with the cameras
-#: level (the default before) and at other iteration budgets, the learned start alone,
+#: start, 40 iterations at most, the front photo's hands fitted, the cameras' pitch
+#: searched), the same with the hands at rest (the default before), with the cameras
+#: level and at other iteration budgets, the learned start alone,
 #: the solver from the mean body (40 iterations, the default before the learned start), the
 #: population search that was the default before that (``thorough``) at its full budget
 #: and at one search alone, and the paper's method at two budgets.
@@ -43,8 +44,9 @@ SETTINGS = {
     "bodyfit: 10 iterations, cameras level": ["--iterations", "10", "--pitch", "level"],
     "bodyfit: 10 iterations, cameras level, the elbows at rest": [
         "--iterations", "10", "--pitch", "level", "--elbows", "rest"],
-    "bodyfit: 40 iterations, cameras level (the default before)": ["--pitch", "level"],
-    "bodyfit (default): 40 iterations, the cameras' pitch searched": [],
+    "bodyfit: 40 iterations, cameras level": ["--pitch", "level"],
+    "bodyfit: 40 iterations, the hands at rest (the default before)": ["--hands", "rest"],
+    "bodyfit (default): 40 iterations, the hands fitted, the cameras' pitch searched": [],
     "bodyfit from the mean body: 40 iterations": ["--start", "mean", "--iterations", "40",
                                                   "--pitch", "level"],
     "thorough: one search 30 x 150": ["--method", "thorough", "--searches", "1",
