@@ -34,7 +34,7 @@ def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label:
             index 1, 2, ... (a generation, say).
     """
     width, height = size_px
-    left, right, top, bottom = 80, 20, 40, 50
+    left, right, top, bottom = 80, 20, 52, 50
     image = np.full((height, width, 3), 255, np.uint8)
     values = {name: np.asarray(v, np.float64) for name, v in series.items()}
     xs = {name: (np.arange(1, len(v) + 1, dtype=np.float64) if x_values is None
@@ -96,9 +96,10 @@ def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label:
     for index, name in enumerate(values):
         cv2.putText(image, name, (x, y + 20 * index), _FONT, 0.5,
                     _COLOURS_BGR[index % len(_COLOURS_BGR)], 1, cv2.LINE_AA)
-    title_width = cv2.getTextSize(title, _FONT, 0.6, 1)[0][0]
-    cv2.putText(image, title, ((width - title_width) // 2, 22), _FONT, 0.6, (0, 0, 0), 1,
-                cv2.LINE_AA)
+    title_scale = min(0.6, 0.6 * (width - 16) / cv2.getTextSize(title, _FONT, 0.6, 1)[0][0])
+    title_width = cv2.getTextSize(title, _FONT, title_scale, 1)[0][0]  # within the chart
+    cv2.putText(image, title, ((width - title_width) // 2, 22), _FONT, title_scale, (0, 0, 0),
+                1, cv2.LINE_AA)
     cv2.putText(image, x_label, (width // 2 - 40, height - 12), _FONT, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
     cv2.putText(image, y_label, (8, top - 10), _FONT, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
     return image

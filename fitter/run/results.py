@@ -120,7 +120,7 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
                            title, "generation", "cost (weighted mm)", log_y=True)
     else:
         chart = line_chart({"cost": result.best_costs}, title, "iteration",
-                           "smooth cost (weighted mm^2)", log_y=True)
+                           "smooth cost (weighted square mm)", log_y=True)
     with staged_directory(out_dir) as stage:
         for name, vertices in (("mesh.obj", fit.posed), ("mesh.ply", fit.posed),
                                ("mesh_rest.ply", fit.rest)):
