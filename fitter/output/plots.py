@@ -20,6 +20,17 @@ def _ticks(low: float, high: float, count: int = 5) -> np.ndarray:
     return np.arange(np.ceil(low / step) * step, high + step / 2, step)
 
 
+def _ink_width(text: str, scale: float) -> int:
+    """Pixels from ``text``'s first to its last inked column as ``cv2.putText`` draws it in
+    ``_FONT`` at ``scale`` (OpenCV 5 draws its own font, in steps of size, not as
+    ``cv2.getTextSize`` says)."""
+    size = cv2.getTextSize(text, _FONT, scale, 1)[0]
+    scratch = np.zeros((3 * size[1] + 8, 3 * size[0] + 8), np.uint8)
+    cv2.putText(scratch, text, (4, 2 * size[1]), _FONT, scale, 255, 1, cv2.LINE_AA)
+    columns = np.flatnonzero(scratch.any(axis=0))
+    return int(columns[-1] - columns[0] + 1) if len(columns) else 0
+
+
 def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label: str,
                size_px: tuple[int, int] = (800, 480), log_y: bool = False,
                x_values: dict[str, np.ndarray] | None = None) -> np.ndarray:
@@ -96,10 +107,11 @@ def line_chart(series: dict[str, np.ndarray], title: str, x_label: str, y_label:
     for index, name in enumerate(values):
         cv2.putText(image, name, (x, y + 20 * index), _FONT, 0.5,
                     _COLOURS_BGR[index % len(_COLOURS_BGR)], 1, cv2.LINE_AA)
-    title_scale = min(0.6, 0.6 * (width - 16) / cv2.getTextSize(title, _FONT, 0.6, 1)[0][0])
-    title_width = cv2.getTextSize(title, _FONT, title_scale, 1)[0][0]  # within the chart
-    cv2.putText(image, title, ((width - title_width) // 2, 22), _FONT, title_scale, (0, 0, 0),
-                1, cv2.LINE_AA)
+    title_scale = 0.6  # smaller until the title fits within the chart (the font's sizes
+    while title_scale > 0.3 and _ink_width(title, title_scale) > width - 16:  # are steps)
+        title_scale -= 0.02
+    cv2.putText(image, title, ((width - _ink_width(title, title_scale)) // 2, 22), _FONT,
+                title_scale, (0, 0, 0), 1, cv2.LINE_AA)
     cv2.putText(image, x_label, (width // 2 - 40, height - 12), _FONT, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
     cv2.putText(image, y_label, (8, top - 10), _FONT, 0.45, (0, 0, 0), 1, cv2.LINE_AA)
     return image

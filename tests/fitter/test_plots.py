@@ -39,7 +39,7 @@ def test_a_long_title_is_scaled_to_stay_within_the_chart():
     """A title wider than the chart at the usual size (a fit's work line) is drawn smaller,
     its ink within the chart's first and last 4 columns."""
     title = ("local solver from the learned start, 7 iterations, then the cameras' pitch "
-             "searched (89 bodies rendered), pinhole")
+             "searched (89 bodies rendered)")  # the demo's work line
     image = line_chart({"cost": np.array([20.0, 15.0])}, title, "x", "y", size_px=(800, 480))
     band = image[:26].min(axis=2) < 128  # the title's dark ink above the plot
     columns = np.flatnonzero(band.any(axis=0))
