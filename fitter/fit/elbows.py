@@ -2,8 +2,8 @@
 its forearm, motions outside the model's rig.
 
 The model's rest pose (Anny's A-pose) bends each forearm forward at the elbow by about
-40 degrees (:attr:`TurnRig.rest_deg` of :func:`elbow_rig`), and its rig turns only the shoulders and hips
-(:mod:`bodyfit.fitter.model.body_model`). So its arms, hung down for a side photo, swing
+40 degrees (:func:`elbow_rig`'s ``rest_deg``), and its rig turns only the shoulders and
+hips (:mod:`bodyfit.fitter.model.body_model`). So its arms, hung down for a side photo, swing
 their hands in front of the belly, where a person's straight arm lays them against the
 thigh; and in a front photo its forearm is foreshortened towards the camera. The local
 solver fits one elbow flexion for both arms and both photos
@@ -24,7 +24,7 @@ directions as it maps bodies.
 The hands: a person in a front photo lets the palms face anywhere from in (the rest
 pose's) to forward, and a palm turned forward shows the camera the hand's breadth where
 the rest pose shows its edge; matching that outline with an edge-on hand, the solver
-moves the wrist and mis-reads the arm's length (by 14 mm, mean absolute, on the
+moves the wrist and misreads the arm's length (by 12 mm, mean absolute, on the
 benchmark's people as they stand). The local solver fits each hand's twist in the front
 photo (``SolverSettings.hands``): each hand-and-wrist vertex turned about its side's
 forearm axis (the mean body's, elbow ring to wrist ring) through the

@@ -81,8 +81,8 @@ TWIST_START_DEG = 45.0
 #: How far (metres, each axis) the solver may move a view's camera from where it was placed.
 _CAMERA_REACH_M = 0.5
 
-__all__ = ["SOLVER_STARTS", "ELBOWS", "HANDS", "SolverSettings", "SolverTrace", "Residuals", "silhouette_edge",
-           "signed_distance", "sample_bilinear", "LocalProblem", "solve", "placement_iterations",
+__all__ = ["SOLVER_STARTS", "ELBOWS", "HANDS", "SolverSettings", "SolverTrace", "Residuals",
+           "silhouette_edge", "signed_distance", "sample_bilinear", "LocalProblem", "solve", "placement_iterations",
            "moved_view"]
 
 
