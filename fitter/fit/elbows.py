@@ -162,7 +162,10 @@ def _about_rings(rig: TurnRig, vertices: np.ndarray, matrices, rows) -> np.ndarr
     out = np.zeros_like(picked)
     for weights, ring, matrix in zip(rig.weights, rig.rings, matrices):
         centre = np.asarray(vertices[..., ring, :], np.float64).mean(axis=-2, keepdims=True)
-        out += weights[rows, None] * ((picked - centre) @ matrix.T)
+        weight = weights[rows]
+        moved = np.flatnonzero(weight)  # the side's turned part: a small share of the body
+        out[..., moved, :] += weight[moved, None] * ((picked[..., moved, :] - centre)
+                                                     @ matrix.T)
     return out
 
 

@@ -181,15 +181,15 @@ def posed_with_jacobian(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarra
     if flexion_deg is None:
         rest = rest[vertices]
         dirs = vertex_dirs[:, vertices].astype(np.float64)
+        if twist_deg is not None:
+            turned += [d[vertices] for d in d_twist]
     else:
         rig = elbow_rig(model)  # only the wanted vertices bent (the rings' centroids whole)
         turned.append(bend_derivative(rig, rest, flexion_deg, vertices))
         if twist_deg is not None:  # the bend is linear: it maps the twists' motions too
-            d_twist = [bent(rig, d, flexion_deg) for d in d_twist]
+            turned += [bent(rig, d, flexion_deg, vertices) for d in d_twist]
         rest = bent(rig, rest, flexion_deg, vertices)
         dirs = bent(rig, vertex_dirs, flexion_deg, vertices)
-    if twist_deg is not None:
-        turned += [d[vertices] for d in d_twist]
     dirs = dirs.transpose(1, 2, 0)  # (N, 3, K)
     rotations = abduction_rotations(np.asarray(pose_deg, np.float64)[None])[0]  # (4, 3, 3)
     weights = model.chain_weights[vertices].astype(np.float64)  # (N, 4)
