@@ -134,10 +134,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "for both arms and photos, solved with the body) or rest (the "
                              "model's rest pose's, about 43 degrees)")
     parser.add_argument("--hands", choices=("fitted", "rest"),  # local_solver.HANDS
-                        help="the front photo's hands: fitted (the default: one twist of "
-                             "both hands about their forearms, from palms in to palms "
-                             "forward, solved with the body) or rest (the model's rest "
-                             "pose's, palms in; the default before)")
+                        help="the front photo's hands: fitted (the default: each hand's "
+                             "twist about its forearm, from palm in to palm forward, solved "
+                             "with the body) or rest (the model's rest pose's, palms in; "
+                             "the default before)")
     parser.add_argument("--pitch", choices=PITCHES,
                         help="the cameras' pitch: searched (the default: the local solver "
                              "run again with each camera pitched 4 degrees down and up, the "

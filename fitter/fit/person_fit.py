@@ -261,7 +261,7 @@ def _scoring(model: BodyModel, views: dict[str, kernels.ViewTarget], settings: F
 def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                    view: kernels.ViewTarget, stature_m: float,
                    condition_stature: bool, flexion_deg: float | None = None,
-                   twist_deg: float | None = None) -> np.ndarray:
+                   twist_deg: np.ndarray | None = None) -> np.ndarray:
     """(V', 3) float64 metres: the body a pinhole view's camera is placed from
     (:func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
     (4,) degrees, its elbows' flexion and front hands' twist, each None for the rest
@@ -288,7 +288,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
 
 def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
                   betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None = None,
-                  twist_deg: float | None = None,
+                  twist_deg: np.ndarray | None = None,
                   pitches: dict[str, float] | None = None) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
     degrees, elbows' flexion and hands' twist or None) as it is rendered
@@ -460,7 +460,7 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
                         problem.lower[:problem.num_genes], problem.upper[:problem.num_genes])
 
     def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None,
-              twist_deg: float | None, turned: dict[str, float] | None = None) -> None:
+              twist_deg: np.ndarray | None, turned: dict[str, float] | None = None) -> None:
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
                       pose_deg, flexion_deg, twist_deg, turned)
         for view in views.values():
@@ -527,7 +527,7 @@ def _pitch_searched(model, views, masks, intrinsics, stature_m, sex: str,
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                   views: dict[str, kernels.ViewTarget], stature_m: float,
                   condition_stature: bool, flexion_deg: float | None = None,
-                  twist_deg: float | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
+                  twist_deg: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
     """The fit's bodies of its answer (betas (K,), pose (4,) degrees, elbows' flexion and
     the front photo's hands' twist, each None for the rest pose's; the posed body has the
     front photo's hands, the rest body the rest pose's), float32 metres:

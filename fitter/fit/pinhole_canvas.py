@@ -45,6 +45,7 @@ import dataclasses
 
 import cv2
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from bodyfit import kernels
 from bodyfit.common.errors import UserError
@@ -90,19 +91,15 @@ class Placement:
         r = view_rotation(name)
         centre = (-self.distance_m * r[2] - self.lateral_m * r[0]
                   + np.array([0.0, 0.0, self.camera_height_m - self.origin_height_m]))
-        roll = np.deg2rad(self.roll_deg)
-        r = (_pitched(self.pitch_deg) @ np.array([[np.cos(roll), -np.sin(roll), 0.0],
-                                                  [np.sin(roll), np.cos(roll), 0.0],
-                                                  [0.0, 0.0, 1.0]]) @ r)
+        r = (_pitched(self.pitch_deg)
+             @ Rotation.from_euler("z", self.roll_deg, degrees=True).as_matrix() @ r)
         return r, -r @ centre
 
 
 def _pitched(pitch_deg: float) -> np.ndarray:
     """(3, 3) the turn of a camera frame by ``pitch_deg`` about its x axis (positive looks
     down): level camera frame -> pitched camera frame."""
-    pitch = np.deg2rad(pitch_deg)
-    return np.array([[1.0, 0.0, 0.0], [0.0, np.cos(pitch), -np.sin(pitch)],
-                     [0.0, np.sin(pitch), np.cos(pitch)]])
+    return Rotation.from_euler("x", pitch_deg, degrees=True).as_matrix()
 
 
 def view_rotation(name: str) -> np.ndarray:
