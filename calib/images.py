@@ -12,8 +12,12 @@ using the tag :func:`read_photo` returns.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import os
+import sys
+import tempfile
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -115,6 +119,25 @@ def _exif_fields(exif: bytes, size_px: tuple[int, int]) -> tuple[int, float | No
     return orientation, focal, source
 
 
+@contextlib.contextmanager
+def _decoder_messages_logged(path: Path):
+    """Within it, what the image decoders write to the process's standard error (libjpeg's
+    "Premature end of JPEG file", say, beside the one line a corrupt photo gets) goes to
+    the debug log instead."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            for line in sink.read().decode(errors="replace").splitlines():
+                log.debug("%s: the decoder said: %s", path, line)
+
+
 def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, list]:
     """``cv2.imreadWithMetadata(path, flags)``: (pixels, metadata kinds, metadata blocks).
 
@@ -124,7 +147,8 @@ def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, lis
     path = Path(path)
     check_input_file(path)
     try:
-        pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), flags)
+        with _decoder_messages_logged(path):
+            pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), flags)
     except cv2.error:  # e.g. a header claiming a width above CV_IO_MAX_IMAGE_WIDTH
         pixels, kinds, blocks = None, [], []
     if pixels is None or pixels.size == 0:

@@ -52,6 +52,27 @@ def test_unreadable_and_missing_files_are_user_errors(tmp_path):
         list(sample_video_frames(junk.rename(tmp_path / "junk.mp4"), 5))
 
 
+def test_a_truncated_jpeg_is_one_user_error_and_nothing_on_stderr(tmp_path, capfd,
+                                                                  asymmetric_image):
+    """The decoder's own complaint (libjpeg's "Premature end of JPEG file", written to the
+    process's standard error) stays off the terminal: the UserError is the one line."""
+    whole = cv2.imencode(".jpg", asymmetric_image)[1].tobytes()
+    truncated = tmp_path / "cut.jpg"
+    truncated.write_bytes(whole[:len(whole) // 3])
+    capfd.readouterr()
+    try:
+        photo = read_photo(truncated)  # libjpeg may fill the rest in grey and warn
+    except UserError as error:
+        assert "not a readable image" in str(error)
+    else:
+        assert photo.pixels.shape == asymmetric_image.shape
+    corrupt = tmp_path / "corrupt.jpg"
+    corrupt.write_bytes(b"\xff\xd8\xff\xe0garbage")
+    with pytest.raises(UserError, match="not a readable image"):
+        read_photo(corrupt)
+    assert capfd.readouterr().err == ""
+
+
 def test_images_of_different_sizes_are_refused(tmp_path):
     for name, shape in (("a.png", (40, 60, 3)), ("b.png", (60, 40, 3))):
         cv2.imwrite(str(tmp_path / name), np.zeros(shape, np.uint8))
