@@ -34,6 +34,17 @@ __all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "person_masks",
 #: most likely given in other units).
 STATURE_RANGE_CM = (100.0, 250.0)
 SEXES = ("female", "male", "unknown")
+#: The narrowest front silhouette accepted, as its width over its height: the arms held
+#: out from the body. The mean body at the search's lowest arm abduction
+#: (``person_fit.ARMS_LOWER_DEG``) is 0.40 wide (0.37-0.44 with any one shape component
+#: at +-3 sigma); with its arms hanging down, 0.25. The standing set's front photos:
+#: 0.55-0.86.
+FRONT_MIN_ASPECT = 0.32
+#: The widest side silhouette accepted, as a share of the front one's aspect. The standing
+#: set's: 0.20-0.35; the widest-bellied model body's side (0.32) against its front at the
+#: lowest arms (0.43): 0.75. A second front photo given as the side: about 1; a broad
+#: body's front with the arms hanging against it: 0.86 (tests/fitter/test_run.py).
+SIDE_MAX_SHARE = 0.8
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,7 +96,8 @@ def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
 
     Raises:
         UserError: unreadable files, no person, several people, a person cut by the frame,
-            photos of another size than the camera's, or front and side swapped.
+            photos of another size than the camera's, front and side swapped, two front
+            photos, or a front photo with the arms against the body.
     """
     inputs.validate()
     camera = load_camera(inputs.camera) if inputs.camera else None
@@ -103,6 +115,11 @@ def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
     if aspect["side"] > aspect["front"]:
         raise UserError(f"the side silhouette is wider than the front one ({aspect['side']:.2f} "
                         f"vs {aspect['front']:.2f} of the height): are --front and --side swapped?")
+    if aspect["front"] < FRONT_MIN_ASPECT or aspect["side"] > SIDE_MAX_SHARE * aspect["front"]:
+        raise UserError(f"the front silhouette is {aspect['front']:.2f} of its height wide and "
+                        f"the side one {aspect['side']:.2f}: photograph the front with the arms "
+                        "held out from the body (an A-pose), the side from the person's left or "
+                        "right (README, 'How to photograph')")
     return masks
 
 

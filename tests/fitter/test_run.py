@@ -192,13 +192,21 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--searches": "1", "--start": "learned"}, "--start learned needs --searches 0"),
     ({"swap": True}, "swapped"),
     ({"blank": True}, "no person"),
+    ({"front twice": True}, r"is (\d\.\d\d) of its height wide and the side one \1: .*the "
+                            "person's left or right"),
+    ({"arms down": True}, "the side one 0.30: .*the arms held out from the body"),
 ])
-def test_bad_input_is_one_line_exit_2_and_writes_nothing(subject, tmp_path, capsys,
+def test_bad_input_is_one_line_exit_2_and_writes_nothing(subject, body_model, tmp_path, capsys,
                                                          change, message):
     folder, truth = subject
     args = dict(zip(person_args(folder, truth)[::2], person_args(folder, truth)[1::2]))
     if change.pop("swap", False):
         args["--front"], args["--side"] = args["--side"], args["--front"]
+    if change.pop("front twice", False):
+        args["--side"] = args["--front"]
+    if change.pop("arms down", False):  # the arms hanging: 45 degrees below the rest A-pose
+        write_subject(tmp_path, body_model, TRUE_BETAS, np.array([-45.0, -45.0, 3.0, 3.0]))
+        args["--front"] = str(tmp_path / "front.png")
     if change.pop("blank", False):
         blank = tmp_path / "blank.png"
         cv2.imwrite(str(blank), np.full((800, 600, 3), 180, np.uint8))
