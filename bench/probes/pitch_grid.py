@@ -4,9 +4,11 @@ For each subject of a standing set, the local solver's level answer (`--pitch le
 eight more solves from it, each camera level or pitched ``PITCH_STEP_DEG`` down or up
 (the 3 x 3 grid, ``PITCH_ITERATIONS`` each, as the fit's search solves them), each
 measured against the truth. Then rules choosing among them, each paired against level:
-the whole grid's best score, the side or the front camera's pitch alone, and the
+the whole grid's best score, the side or the front camera's pitch alone, the
 default's (:func:`bodyfit.fitter.fit.pitch.searched_pitches`: each camera its best
-single-view step, the two together), each scored by cost + a prior per squared degree.
+single-view step, the two together), each scored by cost + a prior per squared degree,
+and the least of a quadratic surface fitted to the grid's scores
+(:func:`quadratic_pitches`; its errors interpolated over the grid, not solved).
 
     PYTHONPATH=. python -m bench.probes.pitch_grid SETS/standing --first 72 > grid.jsonl
     PYTHONPATH=. python -m bench.probes.pitch_grid --rules grid.jsonl
@@ -89,9 +91,12 @@ def _important(point: dict) -> float:
 
 def _chosen(record: dict, rule: str, prior: float) -> dict:
     """The grid point ``rule`` chooses by cost + prior * (sum of squared pitches): the
-    default's (:func:`searched_pitches` over the grid's solves), or the best of the whole
-    grid, of the side camera's pitches alone or of the front camera's."""
+    default's (:func:`searched_pitches` over the grid's solves), the best of the whole
+    grid, of the side camera's pitches alone or of the front camera's; or, for
+    ``"quadratic"``, the point :func:`quadratic_pitches` interpolates."""
     points = {(p["front"], p["side"]): p for p in record["grid"]}
+    if rule == "quadratic":
+        return _interpolated(record, *quadratic_pitches(record, prior))
     if rule == "default":
         def solved(pitches, start):
             point = points[(pitches["front"], pitches["side"])]
@@ -104,13 +109,52 @@ def _chosen(record: dict, rule: str, prior: float) -> dict:
     return points[min(keys, key=score.get)]
 
 
+def _quadratic_weights(front: float, side: float) -> np.ndarray:
+    """(9,) weights of the grid points (``STEPS`` x ``STEPS``, front-major) whose sum
+    interpolates a value at the pitches (``front``, ``side``): Lagrange's quadratic in
+    each view's pitch."""
+    def lagrange(x: float) -> np.ndarray:
+        return np.array([np.prod([(x - o) / (s - o) for o in STEPS if o != s]) for s in STEPS])
+    return np.outer(lagrange(front), lagrange(side)).ravel()
+
+
+def quadratic_pitches(record: dict, prior: float) -> tuple[float, float]:
+    """(front, side) degrees: the least of the quadratic surface fitted (least squares) to
+    the grid's scores (cost + prior * squared pitches), within one step of level; the
+    grid's best point where the surface has no least point."""
+    x = np.array([p["front"] for p in record["grid"]]) / PITCH_STEP_DEG
+    y = np.array([p["side"] for p in record["grid"]]) / PITCH_STEP_DEG
+    score = np.array([p["cost"] + prior * (p["front"] ** 2 + p["side"] ** 2)
+                      for p in record["grid"]])
+    a = np.column_stack([np.ones_like(x), x, y, x * x, x * y, y * y])
+    c = np.linalg.lstsq(a, score, rcond=None)[0]
+    hessian = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]])
+    if np.all(np.linalg.eigvalsh(hessian) > 0):
+        least = np.clip(np.linalg.solve(hessian, -c[1:3]), -1.0, 1.0)
+    else:
+        best = int(np.argmin(score))
+        least = np.array([x[best], y[best]])
+    return float(least[0] * PITCH_STEP_DEG), float(least[1] * PITCH_STEP_DEG)
+
+
+def _interpolated(record: dict, front: float, side: float) -> dict:
+    """A grid point at the pitches (``front``, ``side``): its errors interpolated over the
+    grid (:func:`_quadratic_weights`), as an approximation of a solve there."""
+    points = {(p["front"], p["side"]): p for p in record["grid"]}
+    ordered = [points[(f, s)] for f in STEPS for s in STEPS]
+    weights = _quadratic_weights(front, side)
+    return {"front": front, "side": side,
+            "err": {k: float(weights @ [p["err"][k] for p in ordered])
+                    for k in ordered[0]["err"]}}
+
+
 def rules_table(records: list[dict]) -> str:
     """Markdown: each rule and prior's mean of the 7, paired against level."""
     level = np.array([_important(r["grid"][0]) for r in records])
     lines = [f"{len(records)} subjects, level {level.mean():.2f} mm", "",
              "| rule | " + " | ".join(f"prior {p}" for p in PRIORS) + " |",
              "|---|" + "---|" * len(PRIORS)]
-    for rule in ("default", "grid", "side", "front"):
+    for rule in ("default", "grid", "side", "front", "quadratic"):
         cells = []
         for prior in PRIORS:
             diff = np.array([_important(_chosen(r, rule, prior)) for r in records]) - level
