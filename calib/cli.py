@@ -22,6 +22,7 @@ from bodyfit.calib.capture import (DISTORTION_MODELS, INTRINSIC_NAMES, CaptureSe
                                    describe_views)
 from bodyfit.calib.check import CheckedView, check_calibration, rms_px
 from bodyfit.calib.images import encode_image, read_photo, to_upright, write_image
+from bodyfit.calib.segmenters import SEGMENTERS
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.calib.undistort import undistort_image
 from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
@@ -126,14 +127,21 @@ def _build_parser() -> argparse.ArgumentParser:
 
     silhouette = commands.add_parser(
         "silhouette",
-        help="the person's mask in a photo on a plain backdrop",
-        description="Extract the person's silhouette from a photo on a plain backdrop; writes a black/white PNG "
-        "of the undistorted (with --camera), upright photo.",
+        help="the person's mask in a photo",
+        description="Extract the person's silhouette from a photo (on a plain backdrop, or in a room "
+        "through the learned segmentation); writes a black/white PNG of the undistorted (with --camera), "
+        "upright photo.",
     )
     silhouette.add_argument("photo", metavar="PHOTO")
     silhouette.add_argument("--camera", metavar="camera.json", help="undistort the silhouette with this camera")
     silhouette.add_argument("--background", metavar="PLATE", help="background plate: the same view without the person")
     silhouette.add_argument("-o", "--output", required=True, metavar="mask.png")
+    silhouette.add_argument(
+        "--segmenter", choices=SEGMENTERS, default="auto",
+        help="how the person is told from what is behind them: backdrop (a plain backdrop's colour "
+        "model), learned (a learned person segmentation refined at its outline, for rooms), auto "
+        "(backdrop where the frame border shows a plain backdrop, else learned; the default)",
+    )
 
     board = commands.add_parser(
         "board",
@@ -244,7 +252,8 @@ def _silhouette(args: argparse.Namespace) -> None:
     output = Path(args.output)
     check_writable_dir(output.parent)
     camera = load_camera(args.camera) if args.camera else None
-    mask = photo_silhouette(args.photo, camera, args.background, SilhouetteSettings())
+    mask = photo_silhouette(args.photo, camera, args.background, SilhouetteSettings(),
+                            args.segmenter)
     rows = np.flatnonzero(mask.any(axis=1))
     write_image(output, mask.astype(np.uint8) * 255)
     print(

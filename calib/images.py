@@ -37,6 +37,7 @@ __all__ = [
     "encode_image",
     "frame_name",
     "is_video",
+    "native_messages_logged",
     "read_frames",
     "read_image_file",
     "read_photo",
@@ -120,10 +121,10 @@ def _exif_fields(exif: bytes, size_px: tuple[int, int]) -> tuple[int, float | No
 
 
 @contextlib.contextmanager
-def _decoder_messages_logged(path: Path):
-    """Within it, what the image decoders write to the process's standard error (libjpeg's
-    "Premature end of JPEG file", say, beside the one line a corrupt photo gets) goes to
-    the debug log instead."""
+def native_messages_logged(source: str | Path):
+    """Within it, what native libraries write to the process's standard error goes to the
+    debug log instead, each line under ``source``: libjpeg's "Premature end of JPEG file"
+    beside the one line a corrupt photo gets, LiteRT's note on its CPU delegate."""
     sys.stderr.flush()
     saved = os.dup(2)
     with tempfile.TemporaryFile() as sink:
@@ -135,7 +136,7 @@ def _decoder_messages_logged(path: Path):
             os.close(saved)
             sink.seek(0)
             for line in sink.read().decode(errors="replace").splitlines():
-                log.debug("%s: the decoder said: %s", path, line)
+                log.debug("%s: a native library said: %s", source, line)
 
 
 def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, list]:
@@ -147,7 +148,7 @@ def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, lis
     path = Path(path)
     check_input_file(path)
     try:
-        with _decoder_messages_logged(path):
+        with native_messages_logged(path):
             pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), flags)
     except cv2.error:  # e.g. a header claiming a width above CV_IO_MAX_IMAGE_WIDTH
         pixels, kinds, blocks = None, [], []

@@ -44,6 +44,18 @@ subtraction and shadow detection", 1999):
 
 A backdrop that is not plain, a missing person, a person touching the frame edge and
 several people are UserErrors. A backdrop of the clothes' or skin's colour cannot work.
+
+**Rooms** (``segmenter="learned"``, or ``"auto"`` where no plain backdrop surrounds the
+person: the border is not plain, or the region found reaches the frame's edges, as a
+room's floor taken for the person does): the person's region is where the learned segmentation
+(:mod:`bodyfit.calib.segment`) gives a probability of at least one half (step 3's
+region checks apply to it), and step 4 refines its outline, each pixel's backdrop colour
+the mean of the photo's pixels outside the region within ``surroundings_window_px``
+(a wall, a floor, the shadow beside the feet: whatever lies behind that stretch of the
+outline), except where the person's and the backdrop's local colours differ by less
+than ``learned_min_contrast`` (a shoe's grey sole on a grey floor), where the learned
+side stands; then step 5. The learned mask's own outline runs a few pixels loose at the
+hair and hands.
 """
 
 from __future__ import annotations
@@ -59,6 +71,7 @@ from kornia.morphology import closing, opening
 
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.images import read_image_file, read_photo, to_upright
+from bodyfit.calib.segmenters import SEGMENTERS
 from bodyfit.calib.undistort import undistort_image
 from bodyfit.common.errors import UserError
 
@@ -72,6 +85,14 @@ _SIDE_NAMES = ("top", "bottom", "left", "right")
 
 # Smaller photos leave the backdrop fit and the filters nothing to work on.
 MIN_PHOTO_SIDE_PX = 64
+#: A learned probability of at least this is person.
+_LEARNED_THRESHOLD = 0.5
+
+
+class _NotSurrounded(UserError):
+    """No plain backdrop surrounds the person: the border is not plain, the plate does not
+    match it, or the person's region reaches the frame's edges (``"auto"`` turns to the
+    learned segmentation)."""
 
 
 @dataclass(frozen=True)
@@ -102,6 +123,10 @@ class SilhouetteSettings:
         outline_window_px: side of the window for the local person and backdrop colours, pixels.
         outline_passes: times step 4 runs, each from the outline of the last.
         max_hole_fraction: enclosed holes up to this fraction of the person's area are filled.
+        surroundings_window_px: side of the window whose pixels outside the learned region
+            give the backdrop colour behind the outline, pixels.
+        learned_min_contrast: on the learned region's outline, a pixel whose local person
+            and backdrop colours differ by less (grey levels) keeps the learned side.
     """
 
     border_band_fraction: float = 0.04
@@ -119,6 +144,8 @@ class SilhouetteSettings:
     outline_window_px: int = 11
     outline_passes: int = 8
     max_hole_fraction: float = 0.01
+    surroundings_window_px: int = 51
+    learned_min_contrast: float = 30.0
 
     def __post_init__(self) -> None:
         if self.median_px < 1 or self.median_px % 2 == 0:
@@ -221,7 +248,7 @@ def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray
     edges = (top == 0, top + box_height == height, left == 0, left + box_width == width)
     touching = [side for side, touches in zip(_SIDE_NAMES, edges) if touches]
     if touching:
-        raise UserError(
+        raise _NotSurrounded(
             f"the person touches the {' and '.join(touching)} edge of the photo; step back so that the "
             "whole body is inside the frame with backdrop all around it"
         )
@@ -239,7 +266,7 @@ def _mixing_fraction(pixels: np.ndarray, person: np.ndarray, backdrop: np.ndarra
 
 
 def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
-                    settings: SilhouetteSettings) -> np.ndarray:
+                    settings: SilhouetteSettings, min_contrast: float = 0.0) -> np.ndarray:
     """Move the outline to where edge pixels are half person, half backdrop.
 
     Near the outline a pixel's colour I mixes the person's local colour P and the
@@ -253,7 +280,9 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     outline (where there are any): a limb turns away from the camera at its outline, and
     shaded darker there than further in it made edge pixels look more person than they
     are; a blurred edge makes the nearer colour partly backdrop instead, and the window's
-    decides. Returns the largest region of the result.
+    decides. Where the person's and the backdrop's colours differ by less than
+    ``min_contrast`` (grey levels), the pixel keeps its side (the fraction is noise there).
+    Returns the largest region of the result.
     """
     pixels = image.astype(np.float32)
     marked = region.astype(np.uint8)
@@ -280,8 +309,10 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     fraction = _mixing_fraction(at, person_colour[band], backdrop_at)
     edge_fraction = np.where(edge_weight[band] > 0,
                              _mixing_fraction(at, edge_colour[band], backdrop_at), fraction)
+    decided = np.minimum(fraction, edge_fraction) >= 0.5
+    contrast = np.linalg.norm(person_colour[band] - backdrop_at, axis=1)
     refined = region.copy()
-    refined[band] = np.minimum(fraction, edge_fraction) >= 0.5
+    refined[band] = np.where(contrast >= min_contrast, decided, region[band])
     labels, stats = _components(refined)
     return labels == int(np.argmax(stats[:, cv2.CC_STAT_AREA])) + 1
 
@@ -300,22 +331,27 @@ def extract_silhouette(
     image_bgr: np.ndarray,
     background: np.ndarray | None = None,
     settings: SilhouetteSettings = SilhouetteSettings(),
+    segmenter: str = "auto",
 ) -> np.ndarray:
-    """The person's silhouette in a photo on a plain backdrop.
+    """The person's silhouette in a photo.
 
     Args:
         image_bgr: (H, W, 3) uint8 BGR photo, any orientation, as recorded or undistorted
             (the border band must show backdrop, not the black corners undistortion can leave).
         background: optional (H, W, 3) uint8 BGR background plate: the same view
             without the person. Without one the backdrop is modelled from the frame border.
+            The learned segmentation does not use it.
         settings: thresholds.
+        segmenter: one of :data:`~bodyfit.calib.segmenters.SEGMENTERS`: ``"backdrop"``
+            steps 1-5, ``"learned"`` the module docstring's "Rooms", ``"auto"`` the
+            backdrop's where a plain backdrop surrounds the person, else the learned.
 
     Returns:
         (H, W) bool mask, True on the person.
 
     Raises:
-        UserError: backdrop not plain (or plate not matching), no person, person
-            touching the frame edge, several people.
+        UserError: backdrop not plain (or plate not matching) with ``"backdrop"``, no
+            person, person touching the frame edge, several people.
     """
     if image_bgr.ndim != 3 or image_bgr.shape[2] != 3 or image_bgr.dtype != np.uint8:
         raise ValueError(
@@ -326,6 +362,53 @@ def extract_silhouette(
             f"the photo is {image_bgr.shape[1]}x{image_bgr.shape[0]} pixels; a silhouette needs a photo of at "
             f"least {MIN_PHOTO_SIDE_PX} pixels each way (use the camera's full resolution)"
         )
+    if segmenter not in SEGMENTERS:
+        raise UserError(f"--segmenter must be one of {', '.join(SEGMENTERS)}, got {segmenter!r}")
+    if segmenter != "learned":
+        try:
+            return _backdrop_silhouette(image_bgr, background, settings)
+        except _NotSurrounded as refused:
+            if segmenter == "backdrop":
+                raise
+            log.info("no plain backdrop surrounds the person (%s): the learned segmentation",
+                     refused)
+    return _learned_silhouette(image_bgr, settings)
+
+
+def _learned_silhouette(image_bgr: np.ndarray, settings: SilhouetteSettings) -> np.ndarray:
+    """(H, W) bool: the learned segmentation's person, its outline refined (module
+    docstring, "Rooms")."""
+    from bodyfit.calib.segment import person_segmenter  # LiteRT loads only when used
+
+    found = person_segmenter()(image_bgr)
+    region = _person_region(found.probability >= _LEARNED_THRESHOLD, settings)
+    backdrop = _surroundings(image_bgr, region, settings.surroundings_window_px)
+    for _ in range(settings.outline_passes):
+        region = _refine_outline(image_bgr, region, backdrop, settings,
+                                 settings.learned_min_contrast)
+    return _fill_small_holes(region, settings)
+
+
+def _surroundings(image: np.ndarray, region: np.ndarray, window_px: int) -> np.ndarray:
+    """(H, W, 3) float32: the mean colour of ``image``'s pixels outside ``region`` within a
+    ``window_px`` square about each pixel (0 where there are none)."""
+    outside = (~region).astype(np.float32)
+    window = (window_px, window_px)
+    weight = cv2.boxFilter(outside, -1, window, normalize=False)
+    total = cv2.boxFilter(image.astype(np.float32) * outside[..., None], -1, window,
+                          normalize=False)
+    return total / np.maximum(weight, 1e-6)[..., None]
+
+
+def _backdrop_silhouette(image_bgr: np.ndarray, background: np.ndarray | None,
+                         settings: SilhouetteSettings) -> np.ndarray:
+    """(H, W) bool: steps 1-5 of the module docstring.
+
+    Raises:
+        _NotSurrounded: the border is no plain backdrop (or the plate does not match it),
+            or the person touches the frame's edge.
+        UserError: no person, several people.
+    """
     band = _border_band(image_bgr.shape[:2], settings.border_band_fraction)
     if background is None:
         backdrop = _fit_backdrop(image_bgr, band)
@@ -340,7 +423,7 @@ def extract_silhouette(
 
     lit = band & (brightness >= settings.shadow_min_brightness) & (brightness <= settings.max_highlight_brightness)
     if not lit.any():
-        raise UserError(
+        raise _NotSurrounded(
             "the frame border shows no lit backdrop (it is black, or far darker or brighter than "
             f"the {'background plate' if background is not None else 'modelled backdrop'}); light "
             "a plain backdrop evenly and let it fill the whole frame"
@@ -365,11 +448,11 @@ def extract_silhouette(
         or border_foreground > settings.max_border_foreground_fraction
     ):
         if background is not None:
-            raise UserError(
+            raise _NotSurrounded(
                 "the background plate does not match the photo around the edges; keep the camera and "
                 "the lights still between the plate and the photo"
             )
-        raise UserError(
+        raise _NotSurrounded(
             f"the backdrop is not plain ({border_foreground:.0%} of the frame border differs from it, colour "
             f"spread {chroma_spread:.0f} grey levels); use a single-colour backdrop filling the whole frame, "
             "or give a background plate (--background)"
@@ -401,6 +484,7 @@ def photo_silhouette(
     camera: Camera | None = None,
     background_path: str | Path | None = None,
     settings: SilhouetteSettings = SilhouetteSettings(),
+    segmenter: str = "auto",
 ) -> np.ndarray:
     """Silhouette of the person in a photo file, as the fitter needs it.
 
@@ -414,6 +498,7 @@ def photo_silhouette(
         camera: the calibrated camera, or None to skip undistortion.
         background_path: optional background plate photo (same spot, no person).
         settings: thresholds.
+        segmenter: how the person is found (:func:`extract_silhouette`).
 
     Returns:
         (H', W') bool mask of the undistorted, upright photo.
@@ -422,7 +507,7 @@ def photo_silhouette(
     if camera is not None:
         camera.check_image(photo.pixels, str(photo_path))
     plate = None if background_path is None else read_photo(background_path).pixels
-    mask = extract_silhouette(photo.pixels, plate, settings)
+    mask = extract_silhouette(photo.pixels, plate, settings, segmenter)
     if camera is not None:
         mask = undistort_image(mask.astype(np.float32), camera, str(photo_path)) > 0.5
     log.info("%s: silhouette of %d pixels", photo_path, int(mask.sum()))

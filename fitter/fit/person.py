@@ -20,6 +20,7 @@ import numpy as np
 
 from bodyfit.calib.camera import load_camera
 from bodyfit.calib.images import read_photo
+from bodyfit.calib.segmenters import SEGMENTERS
 from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
@@ -59,6 +60,8 @@ class PersonInputs:
         background_front, background_side: background plates, or None.
         sex: "female", "male" or "unknown" (read by the learned start,
             :mod:`bodyfit.fitter.fit.learned_start`).
+        segmenter: how the photos' silhouettes are taken, one of
+            :data:`bodyfit.calib.silhouette.SEGMENTERS`.
     """
 
     front: str
@@ -70,6 +73,7 @@ class PersonInputs:
     background_front: str | None = None
     background_side: str | None = None
     sex: str = "unknown"
+    segmenter: str = "auto"
 
     def validate(self) -> None:
         lo, hi = STATURE_RANGE_CM
@@ -78,16 +82,20 @@ class PersonInputs:
                             f"got {self.height_cm:g}")
         if self.sex not in SEXES:
             raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
+        if self.segmenter not in SEGMENTERS:
+            raise UserError(f"--segmenter must be one of {', '.join(SEGMENTERS)}, "
+                            f"got {self.segmenter!r}")
         for path in (self.front, self.side, self.camera, self.mask_front, self.mask_side,
                      self.background_front, self.background_side):
             if path is not None:
                 check_input_file(path)
 
 
-def _view_mask(photo: str, mask: str | None, background: str | None, camera) -> np.ndarray:
+def _view_mask(photo: str, mask: str | None, background: str | None, camera,
+               segmenter: str) -> np.ndarray:
     if mask is not None:
         return load_mask(mask)
-    return photo_silhouette(photo, camera, background, SilhouetteSettings())
+    return photo_silhouette(photo, camera, background, SilhouetteSettings(), segmenter)
 
 
 def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
@@ -101,8 +109,10 @@ def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
     """
     inputs.validate()
     camera = load_camera(inputs.camera) if inputs.camera else None
-    masks = {"front": _view_mask(inputs.front, inputs.mask_front, inputs.background_front, camera),
-             "side": _view_mask(inputs.side, inputs.mask_side, inputs.background_side, camera)}
+    masks = {"front": _view_mask(inputs.front, inputs.mask_front, inputs.background_front,
+                                 camera, inputs.segmenter),
+             "side": _view_mask(inputs.side, inputs.mask_side, inputs.background_side, camera,
+                                inputs.segmenter)}
     aspect = {}
     for view, mask in masks.items():
         rows, cols = np.nonzero(mask)

@@ -141,7 +141,7 @@ def test_a_black_photo_is_refused_in_one_line_without_warnings():
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # no NumPy warning about an empty or infinite border
         with pytest.raises(UserError, match="no lit backdrop"):
-            extract_silhouette(np.zeros((200, 150, 3), np.uint8))
+            extract_silhouette(np.zeros((200, 150, 3), np.uint8), segmenter="backdrop")
 
 
 def test_the_shadow_is_really_there(studio):
@@ -159,7 +159,7 @@ def test_background_plate_handles_a_busy_room():
     plate = np.clip(room + rng.normal(0.0, 4.0, room.shape), 0, 255).astype(np.uint8)
     assert iou(extract_silhouette(photo, plate), truth) >= 0.99
     with pytest.raises(UserError, match="backdrop is not plain"):
-        extract_silhouette(photo)
+        extract_silhouette(photo, segmenter="backdrop")
 
 
 def test_small_holes_are_filled_and_large_gaps_kept():
@@ -196,9 +196,11 @@ def test_small_holes_are_filled_and_large_gaps_kept():
     ],
 )
 def test_bad_scenes_are_user_errors(people, complaint):
+    """The backdrop's refusals (its stand-in people are shapes no learned model takes for
+    people)."""
     photo, _ = studio_photo(SIZE, people, np.random.default_rng(3))
     with pytest.raises(UserError, match=complaint):
-        extract_silhouette(photo)
+        extract_silhouette(photo, segmenter="backdrop")
 
 
 def test_plate_of_another_size_is_a_user_error(studio):

@@ -39,7 +39,8 @@ def person_args(folder, truth):
 def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, capsys):
     folder, truth = subject
     out = tmp_path / "out"
-    code, stdout, err = run(capsys, "run", *person_args(folder, truth), "-o", str(out), *BUDGET)
+    code, stdout, err = run(capsys, "run", *person_args(folder, truth), "-o", str(out), *BUDGET,
+                            "--segmenter", "backdrop")
     assert code == 0, err
     assert sorted(p.name for p in out.iterdir()) == sorted(RUN_FILES)
     assert {"overlay_front.png", "overlay_side.png", "report.html"} <= set(RUN_FILES)
@@ -50,6 +51,7 @@ def test_run_writes_every_output_and_fits_the_silhouettes(subject, tmp_path, cap
     # the stature is an input: the fit stands it to within the height's rounding (0.05 mm)
     assert table["stature"]["value_mm"] == pytest.approx(truth["O"], abs=0.2)
     record = json.loads((out / "run.json").read_text())
+    assert record["inputs"]["segmenter"] == "backdrop"
     assert record["settings"]["search"]["optimizer"] == "cmaes"
     assert record["settings"]["side_arms"] == "down"
     assert record["settings"]["search"]["searches"] == 2

@@ -1,0 +1,1 @@
+"""Models shipped with calib (README.md names their source and licence)."""
