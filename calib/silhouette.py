@@ -91,8 +91,8 @@ _LEARNED_THRESHOLD = 0.5
 
 class _NotSurrounded(UserError):
     """No plain backdrop surrounds the person: the border is not plain, the plate does not
-    match it, or the person's region reaches the frame's edges (``"auto"`` turns to the
-    learned segmentation)."""
+    match it, the person's region reaches the frame's edges, or other regions as large
+    stand beside it (``"auto"`` turns to the learned segmentation)."""
 
 
 @dataclass(frozen=True)
@@ -240,7 +240,7 @@ def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray
     largest = int(np.argmax(areas))
     similar = int(np.sum(areas >= settings.max_second_region_ratio * areas[largest]))
     if similar > 1:
-        raise UserError(
+        raise _NotSurrounded(
             f"{similar} person-sized regions differ from the backdrop; photograph one person at a time, "
             "with nothing else in front of the backdrop"
         )
@@ -406,8 +406,8 @@ def _backdrop_silhouette(image_bgr: np.ndarray, background: np.ndarray | None,
 
     Raises:
         _NotSurrounded: the border is no plain backdrop (or the plate does not match it),
-            or the person touches the frame's edge.
-        UserError: no person, several people.
+            the person touches the frame's edge, or several person-sized regions.
+        UserError: no person.
     """
     band = _border_band(image_bgr.shape[:2], settings.border_band_fraction)
     if background is None:

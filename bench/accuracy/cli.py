@@ -25,6 +25,11 @@ Run from the repository root (docs/accuracy.md holds what they measured)::
     # the calibrated ± (fitter/fit/spreads.py) on a setting's fits; --write makes a
     # calibration of them (bodyfit's: fitter/data/spread_calibration.json)
     python -m bench.accuracy spread docs/accuracy-runs/out-of-space/bodyfit.csv --first 72
+    # a room set (the same subjects dressed, in rooms; --first N: only its first N) and
+    # each segmenter's silhouettes of it against the truth masks
+    python -m bench.accuracy make SETS/room-out --kind out-of-space --count 200 --seed 0 \
+        --rooms --first 24
+    python -m bench.accuracy silhouettes SETS/room-out --first 24
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python -m bench.accuracy figures SETS/in --curve "bodyfit=bodyfit" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -40,6 +45,7 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import csv
 import json
 import multiprocessing
 import os
@@ -61,11 +67,15 @@ from bench.accuracy.figures import (colour_bar, distance_panel, errors_per_gener
 from bench.accuracy.report import (failure_lines, important_table, measurement_table,
                                    paired_measurement_table)
 from bench.accuracy.runs import concatenated, joined_scores, keep_run, source_timing, subset
+from bench.accuracy.rooms import wrong_pixels_per_outline_pixel
 from bench.accuracy.scores import KEYS, RunScores
 from bench.accuracy.subject_set import (BOARD, CAMERA_FILE, SQUARE_MM, SetSettings, read_bodies,
                                         read_settings, subject_ids, write_bodies,
                                         write_photos_of_set)
 from bodyfit.calib.images import write_image
+from bodyfit.calib.segmenters import SEGMENTERS
+from bodyfit.calib.silhouette import photo_silhouette
+from bodyfit.common.errors import UserError
 from bodyfit.fitter.batch.tables import (FAILURES_COLUMNS, FAILURES_FILE, SUMMARY_COLUMNS,
                                          SUMMARY_FILE, csv_text, read_table)
 from bodyfit.fitter.fit.spreads import SpreadCalibration, bodyfit_calibration, read_calibration
@@ -89,16 +99,18 @@ def make(args) -> None:
     folder = Path(args.set)
     model = load_model()
     if not (folder / "bodies.npz").exists():
-        settings = (SetSettings.standing(args.count, args.seed, pool_per_sex=args.pool_per_sex)
+        settings = (SetSettings.standing(args.count, args.seed, pool_per_sex=args.pool_per_sex,
+                                         rooms=args.rooms)
                     if args.kind == "standing" else
                     SetSettings(kind=args.kind, count=args.count, seed=args.seed,
-                                pool_per_sex=args.pool_per_sex))
+                                pool_per_sex=args.pool_per_sex, rooms=args.rooms))
         folder.mkdir(parents=True, exist_ok=True)
         write_bodies(model, folder, settings)
         print(f"{folder}: {args.count} {args.kind} bodies drawn")
     if args.bodies_only:
         return
     count = json.loads((folder / "set.json").read_text())["settings"]["count"]
+    count = min(count, args.first or count)
     write_photos_of_set(model, folder, [])  # the board photos, once
     workers = args.workers or os.cpu_count()
     chunks = [list(range(i, count, workers)) for i in range(workers)]
@@ -365,6 +377,29 @@ def figures(args) -> None:
     print(f"wrote {args.docs}/accuracy_error_per_generation.png, {args.docs}/accuracy_meshes.png")
 
 
+def silhouettes(args) -> None:
+    """Markdown: each segmenter's silhouettes of a room set's photos against their truth
+    masks (:func:`.rooms.wrong_pixels_per_outline_pixel`), and the photos it refused."""
+    folder = Path(args.set)
+    subjects = [row["id"] for row in csv.DictReader(open(folder / "subjects.csv"))][:args.first]
+    print(f"{folder}, {len(subjects)} subjects: wrong pixels per outline pixel, mean (median)\n")
+    print("| segmenter | view | photos | refused | wrong pixels per outline pixel |")
+    print("|---|---|---|---|---|")
+    for segmenter in args.segmenter:
+        for view in ("front", "side"):
+            wrong, refused = [], 0
+            for subject in subjects:
+                truth = cv2.imread(str(folder / subject / f"truth_{view}.png"),
+                                   cv2.IMREAD_GRAYSCALE) > 127
+                try:
+                    mask = photo_silhouette(folder / subject / f"{view}.jpg", segmenter=segmenter)
+                except UserError:
+                    refused += 1
+                    continue
+                wrong.append(wrong_pixels_per_outline_pixel(mask, truth))
+            shown = f"{np.mean(wrong):.3f} ({np.median(wrong):.3f})" if wrong else "-"
+            print(f"| {segmenter} | {view} | {len(subjects)} | {refused} | {shown} |")
+
 
 def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
     """The command's arguments, and the fitter batch options after ``--`` (``fit``)."""
@@ -379,6 +414,12 @@ def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
     p.add_argument("--pool-per-sex", type=int, default=400,
                    help="out-of-space: bodies the population sampler's linear map is fitted on")
     p.add_argument("--bodies-only", action="store_true")
+    p.add_argument("--first", type=int, metavar="N",
+                   help="photograph only the first N subjects (the others later, by make again)")
+    p.add_argument("--rooms", action="store_true",
+                   help="dress the subjects and photograph them in the rooms of bench/data/rooms "
+                   "(the same bodies and camera places as the plain set of this kind, count and "
+                   "seed)")
     p.add_argument("--workers", type=int, help="processes photographing (default: the cores)")
     p = sub.add_parser("fit", help="calib capture, then fitter batch on a set")
     p.add_argument("set")
@@ -420,6 +461,10 @@ def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
     p.add_argument("--calibration", metavar="FILE",
                    help="test this calibration (one `--write` made, e.g. from other rows) "
                    "instead of bodyfit's own")
+    p = sub.add_parser("silhouettes", help="a room set's silhouettes against their truth masks")
+    p.add_argument("set", help="a set made with make --rooms")
+    p.add_argument("--first", type=int, help="its first N subjects only")
+    p.add_argument("--segmenter", nargs="+", choices=SEGMENTERS, default=list(SEGMENTERS))
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
@@ -446,4 +491,4 @@ def main(argv: list[str] | None = None) -> None:
         fit(args, batch_options)
     else:
         {"make": make, "keep": keep, "report": report, "spread": spread,
-         "figures": figures}[args.command](args)
+         "silhouettes": silhouettes, "figures": figures}[args.command](args)

@@ -16,8 +16,9 @@ import cv2
 import numpy as np
 from PIL import ExifTags, Image
 
+from bench.accuracy.rooms import RoomScene, room_photo
 from bodyfit.calib.camera import Camera
-from bodyfit.calib.images import FULL_FRAME_DIAGONAL_MM
+from bodyfit.calib.images import FULL_FRAME_DIAGONAL_MM, encode_image
 from bodyfit.common.files import write_atomic
 from bodyfit.fitter.demo.studio_photos import lens_photo
 from bodyfit.fitter.model.body_model import PART_NAMES, BodyModel
@@ -94,11 +95,20 @@ def record(image: np.ndarray, effects: PhotoEffects, rng: np.random.Generator,
 
 def write_photos(folder: Path, model: BodyModel, posed: dict[str, np.ndarray],
                  camera: Camera, shots: dict[str, Shot], effects: PhotoEffects,
-                 rng: np.random.Generator, exif: bytes = b"") -> None:
+                 rng: np.random.Generator, exif: bytes = b"",
+                 scene: RoomScene | None = None) -> None:
     """Write front.jpg and side.jpg of the posed bodies ``posed`` ("front", "side" ->
-    (V, 3) metres) into ``folder``, each from its ``shots`` place, with ``exif``."""
+    (V, 3) metres) into ``folder``, each from its ``shots`` place, with ``exif``; on the
+    plain backdrop, or dressed in ``scene``'s room with truth_front.png and
+    truth_side.png beside them (:mod:`.rooms`)."""
     for view in ("front", "side"):
         shot = shots[view]
-        image = lens_photo(posed[view], model, view, PART_NAMES, camera, shot.distance_m,
-                           shot.camera_height_m, (shot.pitch_deg, 0.0))
+        if scene is None:
+            image = lens_photo(posed[view], model, view, PART_NAMES, camera, shot.distance_m,
+                               shot.camera_height_m, (shot.pitch_deg, 0.0))
+        else:
+            image, truth = room_photo(posed[view], model, view, camera, shot.distance_m,
+                                      shot.camera_height_m, shot.pitch_deg, scene)
+            write_atomic(Path(folder) / f"truth_{view}.png",
+                         encode_image(truth.astype(np.uint8) * 255, ".png"))
         write_atomic(Path(folder) / f"{view}.jpg", record(image, effects, rng, exif))

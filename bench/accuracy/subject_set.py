@@ -39,6 +39,7 @@ import numpy as np
 
 from bench.accuracy.bodies import Bodies, draw_bodies, pose_bodies
 from bench.accuracy.photos import PhotoEffects, Shot, exif_focal, write_photos
+from bench.accuracy.rooms import draw_scene
 from bench.accuracy.stances import StanceSettings, posed_bodies
 from bodyfit.calib.boards import parse_board
 from bodyfit.calib.camera import Camera, camera_fields
@@ -80,6 +81,8 @@ class SetSettings:
         exif_share: standing only: the share of subjects photographed without calibration
             (module docstring).
         stance: standing only: the poses' ranges.
+        rooms: the subjects dressed and photographed in rooms (:mod:`.rooms`), the bodies
+            and camera places those of the plain set of the same kind, count and seed.
     """
 
     kind: str = "in-space"
@@ -94,6 +97,7 @@ class SetSettings:
     pitch_deg: float = 0.0
     exif_share: float = 0.0
     stance: StanceSettings = StanceSettings()
+    rooms: bool = False
 
     @property
     def per_row_camera(self) -> bool:
@@ -215,7 +219,9 @@ def _write_subject(out: Path, model: BodyModel, bodies: Bodies, index: int,
         posed = dict(zip(("front", "side"), pose_bodies(model, bodies, index)))
         record |= {"camera_distance_m": round(shot.distance_m, 4),
                    "camera_height_m": round(shot.camera_height_m, 4)}
-    write_photos(out, model, posed, camera, shots, settings.effects, rng, exif)
+    scene = draw_scene(np.random.default_rng([settings.seed, index, 11])) if settings.rooms \
+        else None
+    write_photos(out, model, posed, camera, shots, settings.effects, rng, exif, scene)
     truth = measurer.measure(bodies.vertices[index])
     write_json(out / "truth.json", {
         "units": "mm",

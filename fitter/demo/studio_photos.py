@@ -83,14 +83,27 @@ def pinhole_photo(vertices, model, view: str, parts, intrinsics: np.ndarray,
     The person's pixels are those the body covers by more than half
     (:func:`pinhole_silhouette`).
     """
-    faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
-    rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m, tilt_deg)
-    image = render_pinhole(vertices, faces, face_parts, intrinsics, rotation, translation,
-                           size_px)
-    body = _covered(vertices, faces, intrinsics, rotation, translation, size_px)
+    image, body = pinhole_layers(vertices, model, view, parts, intrinsics, size_px,
+                                 distance_m, camera_height_m, tilt_deg)
     canvas = np.full_like(image, BACKDROP_BGR)
     canvas[body] = image[body]
     return canvas
+
+
+def pinhole_layers(vertices, model, view: str, parts, intrinsics: np.ndarray,
+                   size_px: tuple[int, int], distance_m: float, camera_height_m: float,
+                   tilt_deg: tuple[float, float] = (0.0, 0.0),
+                   face_colours: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The body of :func:`pinhole_photo` (same arguments) before it is put on a backdrop:
+    ((H, W, 3) uint8 BGR painted on white, (H, W) bool the pixels it covers by more than
+    half). ``face_colours``: (F', 3) BGR for the faces of ``parts`` (in the order
+    :func:`bodyfit.kernels.target.visible_faces` gives them), or None for the parts'
+    colours."""
+    faces, face_parts = visible_faces(model.faces, model.face_parts, parts)
+    rotation, translation = _extrinsics(vertices, view, distance_m, camera_height_m, tilt_deg)
+    image = render_pinhole(vertices, faces, face_parts, intrinsics, rotation, translation,
+                           size_px, face_colours)
+    return image, _covered(vertices, faces, intrinsics, rotation, translation, size_px)
 
 
 def pinhole_silhouette(vertices, model, view: str, parts, intrinsics: np.ndarray,
@@ -118,8 +131,8 @@ def _extrinsics(vertices: np.ndarray, view: str, distance_m: float, camera_heigh
     return Placement(distance_m, camera_height_m, 0.0, -floor, *tilt_deg).extrinsics(view)
 
 
-__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "pinhole_silhouette", "lens_photo",
-           "write_subject", "write_pinhole_photos", "write_pinhole_subject"]
+__all__ = ["SIDE_ARMS", "photo", "pinhole_photo", "pinhole_layers", "pinhole_silhouette",
+           "lens_photo", "write_subject", "write_pinhole_photos", "write_pinhole_subject"]
 
 
 

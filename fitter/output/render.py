@@ -79,7 +79,8 @@ def orthographic_pixels(vertices: np.ndarray, view: str, height_px: int,
 
 def render_pinhole(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarray,
                    intrinsics: np.ndarray, rotation: np.ndarray, translation_m: np.ndarray,
-                   size_px: tuple[int, int]) -> np.ndarray:
+                   size_px: tuple[int, int], face_colours: np.ndarray | None = None
+                   ) -> np.ndarray:
     """Render a body through a pinhole camera (no lens distortion), painter's algorithm.
 
     Args:
@@ -89,14 +90,15 @@ def render_pinhole(vertices: np.ndarray, faces: np.ndarray, face_parts: np.ndarr
         intrinsics: (3, 3) K, pixels; rotation (3, 3) and translation_m (3,): model frame ->
             camera frame (x right, y down, z forward), as :mod:`bodyfit.kernels.view_camera`.
         size_px: (width, height) of the image.
+        face_colours: (F, 3) BGR 0-255 per face, or None for ``PART_COLOURS_BGR`` by part.
 
     Returns:
         (height, width, 3) uint8 BGR image on white; every vertex must be in front of the camera.
     """
     px, depth = pinhole_pixels(vertices, intrinsics, rotation, translation_m)
     image = np.full((size_px[1], size_px[0], 3), 255, np.uint8)
-    return _paint(image, px, -depth, vertices, faces, PART_COLOURS_BGR[face_parts],
-                  -np.asarray(rotation, float)[2])
+    colours = PART_COLOURS_BGR[face_parts] if face_colours is None else face_colours
+    return _paint(image, px, -depth, vertices, faces, colours, -np.asarray(rotation, float)[2])
 
 
 def pinhole_pixels(vertices: np.ndarray, intrinsics: np.ndarray, rotation: np.ndarray,
