@@ -13,8 +13,8 @@ package pulls in a GUI build of OpenCV:
    padding, the detector's zero) at 224 x 224; 2254 SSD anchors each give a box, four
    keypoints and a score. The best box above ``DETECTION_SCORE`` is the person; its
    neighbours (box IoU over ``NMS_IOU``) are averaged into its keypoints, weighted by
-   score. Another box above the score that overlaps none of the kept ones is a second
-   person.
+   score. Another box scoring at least ``SECOND_PERSON_SCORE`` that overlaps none of the
+   kept ones is a second person.
 2. **Region**: a square about keypoint 0 (the hips' centre), its side twice the distance
    to keypoint 1 (a point above the head) times ``REGION_SCALE``, turned so that this
    direction points up.
@@ -39,10 +39,14 @@ import numpy as np
 from bodyfit.calib.images import native_messages_logged
 from bodyfit.common.errors import UserError
 
-__all__ = ["DETECTION_SCORE", "PersonFound", "PersonSegmenter", "person_segmenter"]
+__all__ = ["DETECTION_SCORE", "SECOND_PERSON_SCORE", "PersonFound", "PersonSegmenter",
+           "person_segmenter"]
 
 #: A detection's least score (after the sigmoid) to count as a person.
 DETECTION_SCORE = 0.5
+#: A box apart from the best one with at least this score is a second person (rooms hold
+#: faces in pictures, cushions and the like that score 0.5-0.6).
+SECOND_PERSON_SCORE = 0.8
 #: Boxes overlapping the best one by more than this IoU are the same person.
 NMS_IOU = 0.3
 #: The region's side over twice the hips-to-head distance (MediaPipe's 1.25).
@@ -148,11 +152,11 @@ class PersonSegmenter:
         centre = boxes[:, :2] / _DETECTOR_SIDE + self._anchors
         lo, hi = centre - size / 2, centre + size / 2
         same = _box_iou(lo, hi, best) > NMS_IOU
-        others = np.flatnonzero((score >= DETECTION_SCORE) & ~same)
+        others = np.flatnonzero((score >= SECOND_PERSON_SCORE) & ~same)
         if len(others):
             raise UserError(f"{1 + len(_distinct(lo, hi, score, others))} people found in the "
                             "photo; photograph one person at a time")
-        weight = score * same
+        weight = score * (same & (score >= DETECTION_SCORE))
         keypoints = boxes[:, 4:8].reshape(-1, 2, 2) / _DETECTOR_SIDE + self._anchors[:, None]
         keypoints = (keypoints * weight[:, None, None]).sum(0) / weight.sum()
         return keypoints * side - [pad_x, pad_y], float(score[best])

@@ -127,6 +127,8 @@ class SilhouetteSettings:
             give the backdrop colour behind the outline, pixels.
         learned_min_contrast: on the learned region's outline, a pixel whose local person
             and backdrop colours differ by less (grey levels) keeps the learned side.
+        learned_max_backdrop_spread: so does one whose window's outside pixels spread more
+            than this (RMS about their mean, grey levels: a textured backdrop).
     """
 
     border_band_fraction: float = 0.04
@@ -146,6 +148,7 @@ class SilhouetteSettings:
     max_hole_fraction: float = 0.01
     surroundings_window_px: int = 51
     learned_min_contrast: float = 30.0
+    learned_max_backdrop_spread: float = 20.0
 
     def __post_init__(self) -> None:
         if self.median_px < 1 or self.median_px % 2 == 0:
@@ -266,7 +269,8 @@ def _mixing_fraction(pixels: np.ndarray, person: np.ndarray, backdrop: np.ndarra
 
 
 def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
-                    settings: SilhouetteSettings, min_contrast: float = 0.0) -> np.ndarray:
+                    settings: SilhouetteSettings, min_contrast: float = 0.0,
+                    max_backdrop_spread: float = np.inf) -> np.ndarray:
     """Move the outline to where edge pixels are half person, half backdrop.
 
     Near the outline a pixel's colour I mixes the person's local colour P and the
@@ -281,7 +285,9 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     shaded darker there than further in it made edge pixels look more person than they
     are; a blurred edge makes the nearer colour partly backdrop instead, and the window's
     decides. Where the person's and the backdrop's colours differ by less than
-    ``min_contrast`` (grey levels), the pixel keeps its side (the fraction is noise there).
+    ``min_contrast`` (grey levels), or the window's outside pixels spread (RMS about their
+    mean) over ``max_backdrop_spread`` (a textured backdrop, whose mean is no colour behind
+    the edge), the pixel keeps its side (the fraction is noise there).
     Returns the largest region of the result.
     """
     pixels = image.astype(np.float32)
@@ -310,9 +316,14 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     edge_fraction = np.where(edge_weight[band] > 0,
                              _mixing_fraction(at, edge_colour[band], backdrop_at), fraction)
     decided = np.minimum(fraction, edge_fraction) >= 0.5
-    contrast = np.linalg.norm(person_colour[band] - backdrop_at, axis=1)
+    trusted = np.linalg.norm(person_colour[band] - backdrop_at, axis=1) >= min_contrast
+    if np.isfinite(max_backdrop_spread):
+        square = cv2.boxFilter(np.einsum("hwc,hwc->hw", pixels, pixels) * outside, -1, window,
+                               normalize=False) / np.maximum(backdrop_weight, 1e-6)
+        spread = square - np.einsum("hwc,hwc->hw", backdrop_colour, backdrop_colour)
+        trusted &= np.sqrt(np.maximum(spread[band], 0)) <= max_backdrop_spread
     refined = region.copy()
-    refined[band] = np.where(contrast >= min_contrast, decided, region[band])
+    refined[band] = np.where(trusted, decided, region[band])
     labels, stats = _components(refined)
     return labels == int(np.argmax(stats[:, cv2.CC_STAT_AREA])) + 1
 
@@ -385,7 +396,8 @@ def _learned_silhouette(image_bgr: np.ndarray, settings: SilhouetteSettings) -> 
     backdrop = _surroundings(image_bgr, region, settings.surroundings_window_px)
     for _ in range(settings.outline_passes):
         region = _refine_outline(image_bgr, region, backdrop, settings,
-                                 settings.learned_min_contrast)
+                                 settings.learned_min_contrast,
+                                 settings.learned_max_backdrop_spread)
     return _fill_small_holes(region, settings)
 
 
