@@ -230,7 +230,8 @@ BAD_INPUT_CASES = {
     "no person": (["silhouette", "nobody", "-o", OUT], "no person found"),
     "person touching the frame edge": (["silhouette", "cut", "--segmenter", "backdrop", "-o", OUT],
                                        "touches the bottom edge"),
-    "several people": (["silhouette", "two", "-o", OUT], "2 person-sized regions"),
+    "several people": (["silhouette", "two", "--segmenter", "backdrop", "-o", OUT],
+                       "2 person-sized regions"),
     "output folder is a file": (["silhouette", "nobody", "-o", "view/mask.png"], "is a file"),
     "usage error": (["capture", "--board", "chessboard:9x6"], "required"),
 }
