@@ -22,7 +22,7 @@ from bodyfit.calib.capture import (DISTORTION_MODELS, INTRINSIC_NAMES, CaptureSe
                                    describe_views)
 from bodyfit.calib.check import CheckedView, check_calibration, rms_px
 from bodyfit.calib.images import encode_image, read_photo, to_upright, write_image
-from bodyfit.calib.segmenters import SEGMENTERS
+from bodyfit.calib.segmenters import SEGMENTER_HELP, SEGMENTERS
 from bodyfit.calib.silhouette import SilhouetteSettings, photo_silhouette
 from bodyfit.calib.undistort import undistort_image
 from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
@@ -136,12 +136,7 @@ def _build_parser() -> argparse.ArgumentParser:
     silhouette.add_argument("--camera", metavar="camera.json", help="undistort the silhouette with this camera")
     silhouette.add_argument("--background", metavar="PLATE", help="background plate: the same view without the person")
     silhouette.add_argument("-o", "--output", required=True, metavar="mask.png")
-    silhouette.add_argument(
-        "--segmenter", choices=SEGMENTERS, default="auto",
-        help="how the person is told from what is behind them: backdrop (a plain backdrop's colour "
-        "model), learned (a learned person segmentation refined at its outline, for rooms), auto "
-        "(backdrop where the frame border shows a plain backdrop, else learned; the default)",
-    )
+    silhouette.add_argument("--segmenter", choices=SEGMENTERS, default="auto", help=SEGMENTER_HELP)
 
     board = commands.add_parser(
         "board",

@@ -13,8 +13,8 @@ package pulls in a GUI build of OpenCV:
    padding, the detector's zero) at 224 x 224; 2254 SSD anchors each give a box, four
    keypoints and a score. The best box above ``DETECTION_SCORE`` is the person; its
    neighbours (box IoU over ``NMS_IOU``) are averaged into its keypoints, weighted by
-   score. Another box scoring at least ``SECOND_PERSON_SCORE`` that overlaps none of the
-   kept ones is a second person.
+   score. Other boxes scoring at least ``SECOND_PERSON_SCORE`` apart from it are more
+   people, counted by OpenCV's non-maximum suppression.
 2. **Region**: a square about keypoint 0 (the hips' centre), its side twice the distance
    to keypoint 1 (a point above the head) times ``REGION_SCALE``, turned so that this
    direction points up.
@@ -55,6 +55,8 @@ REGION_SCALE = 1.25
 HEATMAP_KERNEL = 7
 _DETECTOR_SIDE, _LANDMARK_SIDE, _LANDMARKS = 224, 256, 33
 _MODELS = ("pose_detection.tflite", "pose_landmark_full.tflite")
+_NO_PERSON = ("no person found in the photo: photograph the whole person, standing, facing or "
+              "side-on to the camera")
 
 
 @dataclass(frozen=True)
@@ -146,16 +148,17 @@ class PersonSegmenter:
         score = _sigmoid(logits[:, 0])
         best = int(np.argmax(score))
         if score[best] < DETECTION_SCORE:
-            raise UserError("no person found in the photo: photograph the whole person, "
-                            "standing, facing or side-on to the camera")
+            raise UserError(_NO_PERSON)
         size = boxes[:, 2:4] / _DETECTOR_SIDE
         centre = boxes[:, :2] / _DETECTOR_SIDE + self._anchors
         lo, hi = centre - size / 2, centre + size / 2
         same = _box_iou(lo, hi, best) > NMS_IOU
         others = np.flatnonzero((score >= SECOND_PERSON_SCORE) & ~same)
         if len(others):
-            raise UserError(f"{1 + len(_distinct(lo, hi, score, others))} people found in the "
-                            "photo; photograph one person at a time")
+            apart = cv2.dnn.NMSBoxes(np.hstack([lo, hi - lo])[others].tolist(),
+                                     score[others].tolist(), SECOND_PERSON_SCORE, NMS_IOU)
+            raise UserError(f"{1 + len(apart)} people found in the photo; photograph one "
+                            "person at a time")
         weight = score * (same & (score >= DETECTION_SCORE))
         keypoints = boxes[:, 4:8].reshape(-1, 2, 2) / _DETECTOR_SIDE + self._anchors[:, None]
         keypoints = (keypoints * weight[:, None, None]).sum(0) / weight.sum()
@@ -182,8 +185,7 @@ class PersonSegmenter:
         raw, flag, mask_logits, heatmaps, _ = self._run(self._landmarker,
                                                         crop.astype(np.float32) / 255)
         if float(flag[0]) < DETECTION_SCORE:
-            raise UserError("no person found in the photo: photograph the whole person, "
-                            "standing, facing or side-on to the camera")
+            raise UserError(_NO_PERSON)
         landmarks = _refined(raw.reshape(-1, 5)[:_LANDMARKS].copy(), heatmaps)
         xy = landmarks[:, :2] @ to_photo[:, :2].T + to_photo[:, 2]
         landmarks = np.column_stack([xy, landmarks[:, 2] * side / _LANDMARK_SIDE,
@@ -192,17 +194,6 @@ class PersonSegmenter:
                                      to_photo, (width, height), flags=cv2.INTER_LINEAR,
                                      borderMode=cv2.BORDER_CONSTANT, borderValue=0)
         return PersonFound(probability, landmarks, score)
-
-
-def _distinct(lo: np.ndarray, hi: np.ndarray, score: np.ndarray,
-              candidates: np.ndarray) -> list[int]:
-    """The ``candidates`` (box indices) kept by a greedy non-maximum suppression: each
-    other person's best box."""
-    kept: list[int] = []
-    for index in candidates[np.argsort(-score[candidates])]:
-        if all(_box_iou(lo, hi, k)[index] <= NMS_IOU for k in kept):
-            kept.append(int(index))
-    return kept
 
 
 def _refined(landmarks: np.ndarray, heatmaps: np.ndarray) -> np.ndarray:

@@ -77,7 +77,7 @@ from kornia.morphology import closing, opening
 
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.images import read_image_file, read_photo, to_upright
-from bodyfit.calib.segmenters import SEGMENTERS
+from bodyfit.calib.segmenters import check_segmenter
 from bodyfit.calib.undistort import undistort_image
 from bodyfit.common.errors import UserError
 
@@ -280,6 +280,19 @@ def _mixing_fraction(pixels: np.ndarray, person: np.ndarray, backdrop: np.ndarra
     )
 
 
+def _window_mean(values: np.ndarray, selected: np.ndarray, window_px: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """(the mean of the ``selected`` (H, W) bool pixels of ``values`` ((H, W) or (H, W, C)
+    float32) within a ``window_px`` square about each pixel, 0 where there are none;
+    (H, W) float32 how many there are)."""
+    window = (window_px, window_px)
+    weight = cv2.boxFilter(selected.astype(np.float32), -1, window, normalize=False)
+    chosen = values * (selected[..., None] if values.ndim == 3 else selected)
+    total = cv2.boxFilter(chosen, -1, window, normalize=False)
+    share = np.maximum(weight, 1e-6)
+    return total / (share[..., None] if values.ndim == 3 else share), weight
+
+
 def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
                     settings: SilhouetteSettings, min_contrast: float = 0.0,
                     max_backdrop_spread: float = np.inf) -> np.ndarray:
@@ -310,16 +323,13 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     step = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
     second = cv2.erode(marked, step)
     near_inside = second.astype(bool) & ~cv2.erode(second, step).astype(bool)
-    window = (settings.outline_window_px, settings.outline_window_px)
-
-    def local_mean(selected: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        weight = cv2.boxFilter(selected.astype(np.float32), -1, window, normalize=False)
-        total = cv2.boxFilter(pixels * selected[..., None], -1, window, normalize=False)
-        return total / np.maximum(weight, 1e-6)[..., None], weight
-
-    person_colour, person_weight = local_mean(inside)
-    edge_colour, edge_weight = local_mean(near_inside)
-    backdrop_colour, backdrop_weight = local_mean(outside)
+    window = settings.outline_window_px
+    person_colour, person_weight = _window_mean(pixels, inside, window)
+    edge_colour, edge_weight = _window_mean(pixels, near_inside, window)
+    backdrop_colour, backdrop_weight = _window_mean(pixels, outside, window)
+    square, _ = _window_mean(np.einsum("hwc,hwc->hw", pixels, pixels), outside, window)
+    spread = np.sqrt(np.maximum(square - np.einsum("hwc,hwc->hw", backdrop_colour,
+                                                   backdrop_colour), 0))
     no_backdrop_near = backdrop_weight == 0
     backdrop_colour[no_backdrop_near] = backdrop[no_backdrop_near]
     band = ~inside & ~outside & (person_weight > 0)
@@ -328,12 +338,8 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     edge_fraction = np.where(edge_weight[band] > 0,
                              _mixing_fraction(at, edge_colour[band], backdrop_at), fraction)
     decided = np.minimum(fraction, edge_fraction) >= 0.5
-    trusted = np.linalg.norm(person_colour[band] - backdrop_at, axis=1) >= min_contrast
-    if np.isfinite(max_backdrop_spread):
-        square = cv2.boxFilter(np.einsum("hwc,hwc->hw", pixels, pixels) * outside, -1, window,
-                               normalize=False) / np.maximum(backdrop_weight, 1e-6)
-        spread = square - np.einsum("hwc,hwc->hw", backdrop_colour, backdrop_colour)
-        trusted &= np.sqrt(np.maximum(spread[band], 0)) <= max_backdrop_spread
+    trusted = ((np.linalg.norm(person_colour[band] - backdrop_at, axis=1) >= min_contrast)
+               & (spread[band] <= max_backdrop_spread))
     refined = region.copy()
     refined[band] = np.where(trusted, decided, region[band])
     labels, stats = _components(refined)
@@ -385,8 +391,7 @@ def extract_silhouette(
             f"the photo is {image_bgr.shape[1]}x{image_bgr.shape[0]} pixels; a silhouette needs a photo of at "
             f"least {MIN_PHOTO_SIDE_PX} pixels each way (use the camera's full resolution)"
         )
-    if segmenter not in SEGMENTERS:
-        raise UserError(f"--segmenter must be one of {', '.join(SEGMENTERS)}, got {segmenter!r}")
+    check_segmenter(segmenter)
     if segmenter != "learned":
         try:
             return _backdrop_silhouette(image_bgr, background, settings)
@@ -406,7 +411,8 @@ def _learned_silhouette(image_bgr: np.ndarray, settings: SilhouetteSettings) -> 
     found = person_segmenter()(image_bgr)
     region = _person_region(found.probability >= _LEARNED_THRESHOLD, settings)
     region = _person_region(_graph_cut(image_bgr, region, settings), settings)
-    backdrop = _surroundings(image_bgr, region, settings.surroundings_window_px)
+    backdrop, _ = _window_mean(image_bgr.astype(np.float32), ~region,
+                               settings.surroundings_window_px)
     for _ in range(settings.outline_passes):
         region = _refine_outline(image_bgr, region, backdrop, settings,
                                  settings.learned_min_contrast,
@@ -419,7 +425,8 @@ def _graph_cut(image: np.ndarray, learned: np.ndarray, settings: SilhouetteSetti
     """(H, W) bool: OpenCV's GrabCut (colour models of the person and the room, the cut
     drawn along the photo's edges) started from the ``learned`` region: person for sure
     ``grabcut_inside_px`` inside its outline, room for sure ``grabcut_outside_px`` outside
-    it, either in between; over the box about that band only."""
+    it, either in between; over the box about that band only. The same photo gives the
+    same cut whatever ran before (OpenCV's generator is seeded)."""
     def disc(radius: int) -> np.ndarray:
         return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1,) * 2)
     marked = learned.astype(np.uint8)
@@ -431,22 +438,12 @@ def _graph_cut(image: np.ndarray, learned: np.ndarray, settings: SilhouetteSetti
     rows, cols = np.nonzero(near)
     box = (slice(max(rows.min() - 1, 0), rows.max() + 2), slice(max(cols.min() - 1, 0), cols.max() + 2))
     boxed = np.ascontiguousarray(labels[box])
+    cv2.setRNGSeed(0)  # GrabCut's k-means starts from OpenCV's global generator
     cv2.grabCut(np.ascontiguousarray(image[box]), boxed, None, np.zeros((1, 65)),
                 np.zeros((1, 65)), settings.grabcut_iterations, cv2.GC_INIT_WITH_MASK)
     cut = np.zeros(learned.shape, bool)
     cut[box] = (boxed == cv2.GC_FGD) | (boxed == cv2.GC_PR_FGD)
     return cut
-
-
-def _surroundings(image: np.ndarray, region: np.ndarray, window_px: int) -> np.ndarray:
-    """(H, W, 3) float32: the mean colour of ``image``'s pixels outside ``region`` within a
-    ``window_px`` square about each pixel (0 where there are none)."""
-    outside = (~region).astype(np.float32)
-    window = (window_px, window_px)
-    weight = cv2.boxFilter(outside, -1, window, normalize=False)
-    total = cv2.boxFilter(image.astype(np.float32) * outside[..., None], -1, window,
-                          normalize=False)
-    return total / np.maximum(weight, 1e-6)[..., None]
 
 
 def _backdrop_silhouette(image_bgr: np.ndarray, background: np.ndarray | None,

@@ -67,7 +67,7 @@ from bench.accuracy.figures import (colour_bar, distance_panel, errors_per_gener
 from bench.accuracy.report import (failure_lines, important_table, measurement_table,
                                    paired_measurement_table)
 from bench.accuracy.runs import concatenated, joined_scores, keep_run, source_timing, subset
-from bench.accuracy.rooms import wrong_pixels_per_outline_pixel
+from bench.accuracy.outlines import outline_errors
 from bench.accuracy.scores import KEYS, RunScores
 from bench.accuracy.subject_set import (BOARD, CAMERA_FILE, SQUARE_MM, SetSettings, read_bodies,
                                         read_settings, subject_ids, write_bodies,
@@ -379,9 +379,10 @@ def figures(args) -> None:
 
 def silhouettes(args) -> None:
     """Markdown: each segmenter's silhouettes of a room set's photos against their truth
-    masks (:func:`.rooms.wrong_pixels_per_outline_pixel`), and the photos it refused."""
+    masks (:func:`.outlines.outline_errors`), and the photos it refused."""
     folder = Path(args.set)
-    subjects = [row["id"] for row in csv.DictReader(open(folder / "subjects.csv"))][:args.first]
+    with open(folder / "subjects.csv", newline="") as table:
+        subjects = [row["id"] for row in csv.DictReader(table)][:args.first]
     print(f"{folder}, {len(subjects)} subjects: wrong pixels per outline pixel, mean (median)\n")
     print("| segmenter | view | photos | refused | wrong pixels per outline pixel |")
     print("|---|---|---|---|---|")
@@ -396,7 +397,7 @@ def silhouettes(args) -> None:
                 except UserError:
                     refused += 1
                     continue
-                wrong.append(wrong_pixels_per_outline_pixel(mask, truth))
+                wrong.append(outline_errors(mask, truth)[1])
             shown = f"{np.mean(wrong):.3f} ({np.median(wrong):.3f})" if wrong else "-"
             print(f"| {segmenter} | {view} | {len(subjects)} | {refused} | {shown} |")
 

@@ -18,7 +18,7 @@ changes:
 
 Each subject folder also gets ``truth_front.png``/``truth_side.png``: the pixels the body
 covers by more than half, through the same lens, for the silhouettes' wrong pixels
-(:func:`wrong_pixels_per_outline_pixel`).
+(:func:`.outlines.outline_errors`).
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from bodyfit.fitter.demo.studio_photos import pinhole_layers
 from bodyfit.fitter.model.body_model import PART_NAMES, BodyModel
 
 __all__ = ["ROOMS_FOLDER", "SHADOW_DEPTH", "RoomScene", "draw_scene", "dressed_colours",
-           "room_photo", "wrong_pixels_per_outline_pixel"]
+           "room_photo"]
 
 ROOMS_FOLDER = Path(__file__).parents[1] / "data" / "rooms"
 #: The contact shadow darkens the floor by this share at its centre.
@@ -147,10 +147,3 @@ def room_photo(vertices: np.ndarray, model: BodyModel, view: str, camera: Camera
         truth = distort_image(truth, camera.K, camera.dist)
     return canvas, truth > 127
 
-
-def wrong_pixels_per_outline_pixel(mask: np.ndarray, truth: np.ndarray) -> float:
-    """The pixels where ``mask`` and ``truth`` (H, W) bool differ, per pixel of the truth's
-    outline (its pixels with a 4-neighbour outside it)."""
-    inner = cv2.erode(truth.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_CROSS, (3, 3)))
-    outline = int(truth.sum() - inner.sum())
-    return float(np.sum(mask != truth)) / max(outline, 1)

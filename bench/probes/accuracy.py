@@ -31,13 +31,13 @@ import shutil
 import sys
 from pathlib import Path
 
-import cv2
 import numpy as np
 import warp
 from scipy import stats
 
 from bench.accuracy.bodies import pose_bodies
 from bench.accuracy.figures import errors_per_generation
+from bench.accuracy.outlines import outline_errors
 from bench.accuracy.fit_photos import FitPhotos, answer_pose
 from bench.accuracy.report import mean_of_important
 from bench.accuracy.runs import (concatenated, joined_scores, read_source, record_holders,
@@ -137,14 +137,10 @@ def outlines(args) -> None:
             exact = pinhole_silhouette(posed, model, view, PART_NAMES, camera.K,
                                        camera.image_size_px, truth["camera_distance_m"],
                                        truth["camera_height_m"])
-            contours, _ = cv2.findContours(exact.astype(np.uint8), cv2.RETR_EXTERNAL,
-                                           cv2.CHAIN_APPROX_NONE)
-            outline = sum(len(contour) for contour in contours)
             for passes in args.passes:
                 mask = photo_silhouette(folder / ids[index] / f"{view}.jpg", camera,
                                         settings=SilhouetteSettings(outline_passes=passes))
-                extra, missed = int(np.sum(mask & ~exact)), int(np.sum(~mask & exact))
-                offsets[passes].append(((extra - missed) / outline, (extra + missed) / outline))
+                offsets[passes].append(outline_errors(mask, exact))
     print(f"{folder}, the first {args.first} subjects ({2 * args.first} photos), against "
           "the exact silhouettes:\n\n| outline passes | outward offset (px) | pixels wrong "
           "per outline pixel |\n|---|---|---|")

@@ -13,7 +13,7 @@ import sys
 import time
 from pathlib import Path
 
-from bodyfit.calib.segmenters import SEGMENTERS
+from bodyfit.calib.segmenters import SEGMENTER_HELP, SEGMENTERS
 from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
@@ -74,12 +74,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="background plate: the front view without the person")
     parser.add_argument("--background-side", metavar="PHOTO",
                         help="background plate, side view")
-    parser.add_argument("--segmenter", choices=SEGMENTERS,
-                        help="how the person is told from what is behind them: backdrop (a "
-                             "plain backdrop's colour model), learned (a learned person "
-                             "segmentation refined at its outline, for rooms), auto "
-                             "(backdrop where a plain backdrop surrounds the person, else "
-                             "learned; the default)")
+    parser.add_argument("--segmenter", choices=SEGMENTERS, help=SEGMENTER_HELP)
     parser.add_argument("--sex", choices=("female", "male", "unknown"),
                         help="the person's sex, read by the learned start (default "
                              "unknown)"

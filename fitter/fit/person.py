@@ -20,7 +20,7 @@ import numpy as np
 
 from bodyfit.calib.camera import load_camera
 from bodyfit.calib.images import read_photo
-from bodyfit.calib.segmenters import SEGMENTERS
+from bodyfit.calib.segmenters import check_segmenter
 from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
@@ -61,7 +61,7 @@ class PersonInputs:
         sex: "female", "male" or "unknown" (read by the learned start,
             :mod:`bodyfit.fitter.fit.learned_start`).
         segmenter: how the photos' silhouettes are taken, one of
-            :data:`bodyfit.calib.silhouette.SEGMENTERS`.
+            :data:`bodyfit.calib.segmenters.SEGMENTERS`.
     """
 
     front: str
@@ -82,9 +82,7 @@ class PersonInputs:
                             f"got {self.height_cm:g}")
         if self.sex not in SEXES:
             raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
-        if self.segmenter not in SEGMENTERS:
-            raise UserError(f"--segmenter must be one of {', '.join(SEGMENTERS)}, "
-                            f"got {self.segmenter!r}")
+        check_segmenter(self.segmenter)
         for path in (self.front, self.side, self.camera, self.mask_front, self.mask_side,
                      self.background_front, self.background_side):
             if path is not None:

@@ -9,8 +9,9 @@ import cv2
 import numpy as np
 import pytest
 
+from bench.accuracy.outlines import outline_errors
 from bench.accuracy.rooms import (SHADOW_DEPTH, RoomScene, _room, draw_scene, dressed_colours,
-                                  room_photo, wrong_pixels_per_outline_pixel)
+                                  room_photo)
 from bench.accuracy.subject_set import SetSettings, write_bodies, write_photos_of_set
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.silhouette import extract_silhouette
@@ -19,13 +20,16 @@ from bodyfit.fitter.demo.studio_photos import pinhole_layers
 from bodyfit.fitter.model.body_model import PART_NAMES
 
 
-def test_wrong_pixels_per_outline_pixel_of_a_shifted_square():
+def test_outline_errors_of_a_shifted_and_a_grown_square():
     """A 10 x 10 square's outline is its 36 border pixels; shifted by a column, the mask
-    is wrong on 20 pixels."""
+    is wrong on 20 pixels and no further out; grown by a pixel all round, 44 pixels out."""
     truth = np.zeros((20, 20), bool)
     truth[5:15, 5:15] = True
-    assert wrong_pixels_per_outline_pixel(truth, truth) == 0.0
-    assert wrong_pixels_per_outline_pixel(np.roll(truth, 1, axis=1), truth) == pytest.approx(20 / 36)
+    assert outline_errors(truth, truth) == (0.0, 0.0)
+    assert outline_errors(np.roll(truth, 1, axis=1), truth) == pytest.approx((0.0, 20 / 36))
+    grown = np.zeros_like(truth)
+    grown[4:16, 4:16] = True
+    assert outline_errors(grown, truth) == pytest.approx((44 / 36, 44 / 36))
 
 
 def test_a_scene_is_drawn_from_its_stream_and_dresses_by_part(body_model):

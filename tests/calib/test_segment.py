@@ -91,3 +91,12 @@ def test_landmarks_lie_on_the_person():
     assert y[NOSE] < y[23] < y[27] and y[NOSE] < y[24] < y[28]
     assert x[11] > x[12] and x[15] > x[16]  # shoulders, wrists
     assert 0.9 < found.score <= 1.0
+
+
+def test_the_same_photo_gives_the_same_mask_whatever_ran_before():
+    """GrabCut's k-means draws from OpenCV's global generator: disturbed between two
+    extractions, the masks are still the same."""
+    image = photo("saif2")
+    first = extract_silhouette(image, segmenter="learned")
+    cv2.randu(np.zeros((100, 100), np.uint8), 0, 255)
+    assert np.array_equal(extract_silhouette(image, segmenter="learned"), first)
