@@ -39,8 +39,8 @@ import numpy as np
 from bodyfit.calib.images import native_messages_logged
 from bodyfit.common.errors import UserError
 
-__all__ = ["DETECTION_SCORE", "SECOND_PERSON_SCORE", "PersonFound", "PersonSegmenter",
-           "person_segmenter"]
+__all__ = ["DETECTION_SCORE", "SECOND_PERSON_SCORE", "NoPersonFound", "PersonFound",
+           "PersonSegmenter", "person_segmenter"]
 
 #: A detection's least score (after the sigmoid) to count as a person.
 DETECTION_SCORE = 0.5
@@ -57,6 +57,13 @@ _DETECTOR_SIDE, _LANDMARK_SIDE, _LANDMARKS = 224, 256, 33
 _MODELS = ("pose_detection.tflite", "pose_landmark_full.tflite")
 _NO_PERSON = ("no person found in the photo: photograph the whole person, standing, facing or "
               "side-on to the camera")
+
+
+class NoPersonFound(UserError):
+    """The models found no one in the photo."""
+
+    def __init__(self) -> None:
+        super().__init__(_NO_PERSON)
 
 
 @dataclass(frozen=True)
@@ -148,7 +155,7 @@ class PersonSegmenter:
         score = _sigmoid(logits[:, 0])
         best = int(np.argmax(score))
         if score[best] < DETECTION_SCORE:
-            raise UserError(_NO_PERSON)
+            raise NoPersonFound()
         size = boxes[:, 2:4] / _DETECTOR_SIDE
         centre = boxes[:, :2] / _DETECTOR_SIDE + self._anchors
         lo, hi = centre - size / 2, centre + size / 2
@@ -185,7 +192,7 @@ class PersonSegmenter:
         raw, flag, mask_logits, heatmaps, _ = self._run(self._landmarker,
                                                         crop.astype(np.float32) / 255)
         if float(flag[0]) < DETECTION_SCORE:
-            raise UserError(_NO_PERSON)
+            raise NoPersonFound()
         landmarks = _refined(raw.reshape(-1, 5)[:_LANDMARKS].copy(), heatmaps)
         xy = landmarks[:, :2] @ to_photo[:, :2].T + to_photo[:, 2]
         landmarks = np.column_stack([xy, landmarks[:, 2] * side / _LANDMARK_SIDE,

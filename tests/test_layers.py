@@ -17,8 +17,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 #: The fitter's sub-packages, lowest first: each may import those before it, not after.
-FITTER_LAYERS = ("model", "measure", "model_build", "fit", "output", "training", "run", "batch",
-                 "demo", "cli")
+FITTER_LAYERS = ("model", "measure", "model_build", "check", "fit", "output", "training", "run",
+                 "batch", "demo", "cli")
 
 #: The other top-level packages -> the bodyfit packages they may import.
 ALLOWED = {

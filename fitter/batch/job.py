@@ -85,8 +85,8 @@ def one_line(text: str) -> str:
 def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object],
                 out_dir: Path) -> SubjectJob:
     """The job of one row: the row's inputs (its camera and sex, else the batch's
-    ``options["camera"]`` and ``options["sex"]``; the batch's background plates and
-    segmenter) and
+    ``options["camera"]`` and ``options["sex"]``; the batch's background plates,
+    segmenter and photography check) and
     ``base`` with the batch's fit options (:func:`~bodyfit.fitter.run.options.fit_settings`),
     the row's weights replacing ``--weights`` (``--weight`` overrides still apply).
 
@@ -107,6 +107,7 @@ def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object
         background_front=options.get("background_front"),
         background_side=options.get("background_side"),
         segmenter=options.get("segmenter") or "auto",
+        check=options.get("check") is not False,
         sex=given.sex if given.sex != "unknown" else options.get("sex") or "unknown")
     if row.weights is not None:
         options = {**options, "weights": row.weights}

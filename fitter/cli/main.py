@@ -75,6 +75,8 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     parser.add_argument("--background-side", metavar="PHOTO",
                         help="background plate, side view")
     parser.add_argument("--segmenter", choices=SEGMENTERS, help=SEGMENTER_HELP)
+    parser.add_argument("--no-check", dest="check", action="store_const", const=False,
+                        help="skip the photography check (fitter check) before the fit")
     parser.add_argument("--sex", choices=("female", "male", "unknown"),
                         help="the person's sex, read by the learned start (default "
                              "unknown)"
@@ -223,6 +225,26 @@ def _build_parser() -> argparse.ArgumentParser:
                       help="which body, camera place and board poses are drawn (default 0)")
     demo.add_argument("--method", choices=("bodyfit", "thorough", "paper"),
                       help="fitter run's --method (default bodyfit)")
+
+    check = sub.add_parser(
+        "check", help="the photography check: is each photo one the fit can measure? "
+                      "(fitter run runs it first)",
+        description="Check a front and a side photo before fitting them: one person, the "
+                    "whole body in the frame with a margin, large enough, upright, the "
+                    "camera level at a sensible height; the front facing the camera, arms "
+                    "and feet apart (an A-pose); the side turned 90 degrees, arms hanging "
+                    "down. Prints what it read of each photo; each problem is one line that "
+                    "says what to do, and the exit status is 2. Loose clothing is a warning "
+                    "(docs/fitter.md, The photography check).")
+    check.add_argument("front", metavar="FRONT", help="front photo, A-pose")
+    check.add_argument("side", metavar="SIDE", help="side photo, arms hanging down")
+    check.add_argument("--camera", metavar="camera.json",
+                       help="the calibrated camera: the photos are undistorted first")
+    check.add_argument("--segmenter", choices=SEGMENTERS, default="auto", help=SEGMENTER_HELP)
+    check.add_argument("--background-front", metavar="PHOTO",
+                       help="background plate: the front view without the person")
+    check.add_argument("--background-side", metavar="PHOTO",
+                       help="background plate, side view")
 
     run = sub.add_parser(
         "run", help="fit the body model to a person's front and side photos: mesh (m), "
@@ -444,6 +466,8 @@ def _cmd_run(args) -> None:
                                   progress=None if not args.quiet else False)
     except ValueError as exc:  # the kernels' argument and device errors, --matching
         raise UserError(str(exc)) from None
+    for line in fit.photos.get("check_warnings", ()):
+        print(f"fitter: warning: {line}", file=sys.stderr)
     result = fit.search
     print(f"fitted in {sum(fit.seconds.values()):.1f} s: {fit_work(settings, result)}, "
           f"cost {result.cost:.1f} weighted mm")
@@ -455,6 +479,27 @@ def _cmd_run(args) -> None:
     print("wrote:")
     for path in written:
         print(f"  {path}")
+
+
+def _cmd_check(args) -> int:
+    from bodyfit.fitter.fit.person import PersonInputs, checked_photos
+
+    inputs = PersonInputs(args.front, args.side, float("nan"),  # the check reads no stature
+                          camera=args.camera,
+                          background_front=args.background_front,
+                          background_side=args.background_side, segmenter=args.segmenter)
+    verdicts = checked_photos(inputs)
+    for verdict in verdicts:
+        print(verdict.summary())
+        for line in verdict.warnings:
+            print(f"fitter: warning: {line}", file=sys.stderr)
+    problems = [line for verdict in verdicts for line in verdict.problems]
+    for line in problems:
+        print(f"fitter: error: {line}", file=sys.stderr)
+    if problems:
+        return 2
+    print("the photos pass the check")
+    return 0
 
 
 def _batch_engine(args, model_sha256: str):
@@ -614,15 +659,16 @@ def main(argv: list[str] | None = None) -> int:
     import warp  # Warp prints its banner and module loads at INFO; the CLI keeps to errors
 
     warp.config.log_level = warp.LOG_ERROR
-    command = {"batch": _cmd_batch, "demo": _cmd_demo, "measure": _cmd_measure,
-               "run": _cmd_run}.get(args.command)
+    command = {"batch": _cmd_batch, "check": _cmd_check, "demo": _cmd_demo,
+               "measure": _cmd_measure, "run": _cmd_run}.get(args.command)
     if args.command == "model":
         command = {"build": _cmd_model_build, "info": _cmd_model_info,
                    "train-start": _cmd_model_train_start}[args.model_command]
     try:
         code = command(args)
-    except UserError as exc:
-        print(f"fitter: error: {exc}", file=sys.stderr)
+    except UserError as exc:  # the photography check's: one line per problem
+        for line in str(exc).splitlines():
+            print(f"fitter: error: {line}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("fitter: interrupted", file=sys.stderr)

@@ -19,17 +19,19 @@ import dataclasses
 import numpy as np
 
 from bodyfit.calib.camera import load_camera
-from bodyfit.calib.images import read_photo
+from bodyfit.calib.images import read_photo, to_upright
 from bodyfit.calib.segmenters import check_segmenter
 from bodyfit.calib.silhouette import SilhouetteSettings, load_mask, photo_silhouette
+from bodyfit.calib.undistort import undistort_image
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
+from bodyfit.fitter.check.photos import PhotoCheckFailed, ViewVerdict, check_view, failed_lines
 from bodyfit.fitter.fit.facing import side_seen
 from bodyfit.fitter.fit.pinhole_canvas import (PHONE_HFOV_DEG, phone_intrinsics,
                                                upright_intrinsics)
 
-__all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "person_masks",
-           "view_intrinsics", "person_silhouettes"]
+__all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "checked_photos",
+           "person_masks", "upright_photo", "view_intrinsics", "person_silhouettes"]
 
 #: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
 #: most likely given in other units).
@@ -62,6 +64,8 @@ class PersonInputs:
             :mod:`bodyfit.fitter.fit.learned_start`).
         segmenter: how the photos' silhouettes are taken, one of
             :data:`bodyfit.calib.segmenters.SEGMENTERS`.
+        check: run the photography check (:mod:`bodyfit.fitter.check.photos`) before
+            the fit (``--no-check``: False).
     """
 
     front: str
@@ -74,6 +78,7 @@ class PersonInputs:
     background_side: str | None = None
     sex: str = "unknown"
     segmenter: str = "auto"
+    check: bool = True
 
     def validate(self) -> None:
         lo, hi = STATURE_RANGE_CM
@@ -82,6 +87,10 @@ class PersonInputs:
                             f"got {self.height_cm:g}")
         if self.sex not in SEXES:
             raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
+        self.validate_photos()
+
+    def validate_photos(self) -> None:
+        """The segmenter and the files (what the photography check reads)."""
         check_segmenter(self.segmenter)
         for path in (self.front, self.side, self.camera, self.mask_front, self.mask_side,
                      self.background_front, self.background_side):
@@ -96,6 +105,38 @@ def _view_mask(photo: str, mask: str | None, background: str | None, camera,
     return photo_silhouette(photo, camera, background, SilhouetteSettings(), segmenter)
 
 
+def _masks(inputs: PersonInputs, camera) -> dict[str, np.ndarray]:
+    return {"front": _view_mask(inputs.front, inputs.mask_front, inputs.background_front,
+                                camera, inputs.segmenter),
+            "side": _view_mask(inputs.side, inputs.mask_side, inputs.background_side, camera,
+                               inputs.segmenter)}
+
+
+def upright_photo(path: str, camera) -> np.ndarray:
+    """(H, W, 3) uint8 BGR, the photo undistorted (with a camera) and turned upright, as
+    its silhouette is."""
+    photo = read_photo(path)
+    pixels = photo.pixels if camera is None else undistort_image(photo.pixels, camera, path)
+    return to_upright(pixels, photo.orientation)
+
+
+def checked_photos(inputs: PersonInputs, masks: dict[str, np.ndarray] | None = None
+                   ) -> list[ViewVerdict]:
+    """The photography check of the person's photos, front then side
+    (:func:`bodyfit.fitter.check.photos.check_view`), on ``masks`` (default: their
+    silhouettes, without :func:`person_masks`' own refusals). Of ``inputs`` it reads the
+    photos, masks, background plates, camera and segmenter only.
+
+    Raises:
+        UserError: unreadable files, no person, several people, a person cut by the frame.
+    """
+    inputs.validate_photos()
+    camera = load_camera(inputs.camera) if inputs.camera else None
+    masks = masks or _masks(inputs, camera)
+    return [check_view(view, upright_photo(getattr(inputs, view), camera), masks[view])
+            for view in ("front", "side")]
+
+
 def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
     """{"front": mask, "side": mask}: (H, W) bool silhouettes of the upright photos, as
     they are (the side one not mirrored).
@@ -107,10 +148,7 @@ def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
     """
     inputs.validate()
     camera = load_camera(inputs.camera) if inputs.camera else None
-    masks = {"front": _view_mask(inputs.front, inputs.mask_front, inputs.background_front,
-                                 camera, inputs.segmenter),
-             "side": _view_mask(inputs.side, inputs.mask_side, inputs.background_side, camera,
-                                inputs.segmenter)}
+    masks = _masks(inputs, camera)
     aspect = {}
     for view, mask in masks.items():
         rows, cols = np.nonzero(mask)
@@ -181,23 +219,35 @@ class PersonPhotos:
         camera_source: where K came from (:func:`view_intrinsics`; "" orthographic).
         side_from: which side of the person the side photo shows: "left", "right", or
             "left (assumed)" when the feet do not tell.
+        check: the photography check's warnings, one line each; None where it was not run.
     """
 
     masks: dict[str, np.ndarray]
     intrinsics: dict[str, np.ndarray] | None
     camera_source: str
     side_from: str
+    check: tuple[str, ...] | None = None
 
 
 def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
     """What a fit takes of the person's photos (:class:`PersonPhotos`): their masks
-    (:func:`person_masks`) and, for the ``"pinhole"`` projection, their cameras
-    (:func:`view_intrinsics`); a side photo from the person's right mirrored.
+    (:func:`person_masks`), when ``inputs.check`` the photography check
+    (:func:`checked_photos`; its problems stop the fit, its warnings are kept), and, for
+    the ``"pinhole"`` projection, their cameras (:func:`view_intrinsics`); a side photo
+    from the person's right mirrored.
 
     Raises:
         UserError: as :func:`person_masks` and :func:`view_intrinsics`.
+        PhotoCheckFailed: the check's problems, one line each (after the masks' own
+            refusals, each a single line that names the problem of the pair).
     """
     masks = person_masks(inputs)
+    warnings = None
+    if inputs.check:
+        verdicts = checked_photos(inputs, masks)
+        if failed_lines(verdicts):
+            raise PhotoCheckFailed("\n".join(failed_lines(verdicts)))
+        warnings = tuple(line for verdict in verdicts for line in verdict.warnings)
     intrinsics, source = (view_intrinsics(inputs, masks) if projection == "pinhole"
                           else (None, ""))
     seen = side_seen(masks["side"])
@@ -207,4 +257,4 @@ def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
             mirrored = intrinsics["side"].copy()
             mirrored[0, 2] = masks["side"].shape[1] - 1 - mirrored[0, 2]
             intrinsics = intrinsics | {"side": mirrored}
-    return PersonPhotos(masks, intrinsics, source, seen or "left (assumed)")
+    return PersonPhotos(masks, intrinsics, source, seen or "left (assumed)", warnings)

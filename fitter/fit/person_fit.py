@@ -180,8 +180,12 @@ class Fit:
             scored it in that view (its pose with the view's fixed angles, e.g. the side
             view's arms down; not rescaled to the stature): what the view's canvas shows.
         photos: what was read of the photos besides their masks (:func:`fit_inputs`):
-            ``camera`` (where K came from) and ``side_from`` (which side the side photo
-            shows); empty for a fit of masks.
+            ``camera`` (where K came from), ``side_from`` (which side the side photo
+            shows) and, where the photography check ran, ``check_warnings`` (its
+            warnings, one line each); empty for a fit of masks.
+        masks: view name -> (H, W) bool, the silhouettes of the upright photos as fitted
+            (:attr:`~bodyfit.fitter.fit.person.PersonPhotos.masks`); empty for a fit of
+            masks.
     """
 
     search: SearchResult
@@ -193,7 +197,8 @@ class Fit:
     views: dict[str, kernels.ViewTarget]
     seconds: dict[str, float]
     view_bodies: dict[str, np.ndarray]
-    photos: dict[str, str] = dataclasses.field(default_factory=dict)
+    photos: dict[str, object] = dataclasses.field(default_factory=dict)
+    masks: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
 
 
 def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
@@ -664,7 +669,9 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
     fit = fit_person(model, photos.masks, inputs.height_cm / 100.0, settings, progress,
                      photos.intrinsics, inputs.sex)
     read = {"camera": photos.camera_source or "orthographic", "side_from": photos.side_from}
+    if photos.check is not None:
+        read["check_warnings"] = list(photos.check)
     if settings.projection == "pinhole":
         read["pitch_deg"] = {name: round(view_pitch_deg(view), 2) + 0.0  # not -0.0
                              for name, view in fit.views.items()}
-    return dataclasses.replace(fit, photos=read)
+    return dataclasses.replace(fit, photos=read, masks=photos.masks)
