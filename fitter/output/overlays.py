@@ -26,7 +26,7 @@ from bodyfit.fitter.output.render import PART_COLOURS_BGR, parts_legend
 from bodyfit.kernels.target import visible_faces
 
 __all__ = ["MatchedContours", "match_contours", "overlay_image", "fitted_outline_image",
-           "OVERLAY_SCALE"]
+           "outline_in_photo", "photo_outline_image", "OVERLAY_SCALE", "PHOTO_HEIGHT_PX"]
 
 #: Upscaling of the overlays over the canvas, for legibility.
 OVERLAY_SCALE = 2
@@ -35,6 +35,9 @@ _PERSON_BGR = (212, 212, 212)
 _PERSON_EDGE_BGR = (40, 40, 40)
 _TINT = 0.35
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
+#: The height of the photo with the fitted outline, pixels (the person's box and a margin).
+PHOTO_HEIGHT_PX = 720
+_MASK_EDGE_BGR = (255, 255, 255)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -151,6 +154,7 @@ def _with_legend(image: np.ndarray, title: str, entries: list[tuple[tuple, str]]
     for i, (colour, text) in enumerate(entries):
         y = 20 + 24 * (len(PART_NAMES) + i)
         cv2.rectangle(legend, (8, y - 12), (26, y + 4), colour, -1)
+        cv2.rectangle(legend, (8, y - 12), (26, y + 4), (0, 0, 0), 1)
         cv2.putText(legend, text, (34, y + 2), _FONT, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
     band = 30
     height = max(image.shape[0], legend.shape[0]) + band
@@ -196,3 +200,71 @@ def fitted_outline_image(matched: MatchedContours) -> np.ndarray:
         cv2.line(image, tuple(outline[i, 0]), tuple(outline[j, 0]), colour, 2, cv2.LINE_AA)
     return _with_legend(image, f"{matched.view}: person and fitted outline",
                         [((110, 110, 110), "person")])
+
+
+def _canvas_to_photo(canvas_mask: np.ndarray, photo_mask: np.ndarray, points: np.ndarray
+                     ) -> np.ndarray:
+    """(N, 2) canvas points -> photo pixels. The canvas holds the photo's silhouette moved
+    and scaled alike along both axes (:mod:`bodyfit.fitter.fit.canvas`,
+    :mod:`bodyfit.fitter.fit.pinhole_canvas`), so the map is the one that takes the canvas
+    silhouette's area and centroid onto the photo's."""
+    def centroid(mask):
+        rows, cols = np.nonzero(mask)
+        return np.array([cols.mean(), rows.mean()])
+
+    scale = np.sqrt(photo_mask.sum() / canvas_mask.sum())
+    return centroid(photo_mask) + scale * (points - centroid(canvas_mask))
+
+
+def outline_in_photo(matched: MatchedContours, mask: np.ndarray, mirrored: bool = False
+                     ) -> np.ndarray:
+    """(M, 2) float64 the fitted body's outline (``matched.body``, its parts
+    ``matched.body_parts``) in the pixels of the person's photo: moved onto the person by
+    the inverse registration, then from the canvas into the photo.
+
+    Args:
+        matched: the view's matched contours.
+        mask: (H, W) bool, the photo's silhouette as fitted (mirrored when ``mirrored``).
+        mirrored: the fit saw the photo mirrored (a side photo from the person's right):
+            the outline is mirrored back onto the photo as taken.
+    """
+    outline = _canvas_to_photo(matched.silhouette, mask, matched.body_on_person(matched.body))
+    if mirrored:
+        outline[:, 0] = mask.shape[1] - 1 - outline[:, 0]
+    return outline
+
+
+def photo_outline_image(matched: MatchedContours, photo: np.ndarray, mask: np.ndarray,
+                        mirrored: bool = False) -> np.ndarray:
+    """(H', W', 3) uint8 BGR: the person's own photo, cut to the person with a margin, the
+    silhouette's outline in white and the fitted body's (:func:`outline_in_photo`) over it
+    coloured by part, ``PHOTO_HEIGHT_PX`` tall, titled, with a legend.
+
+    Args:
+        matched, mask, mirrored: as :func:`outline_in_photo`.
+        photo: (H, W, 3) uint8 BGR, the photo upright (and undistorted), as the user gave it.
+    """
+    outline = outline_in_photo(matched, mask, mirrored)
+    if mirrored:
+        mask = mask[:, ::-1]
+    edge = contour_points(mask)
+    rows, cols = np.nonzero(mask)
+    margin = 0.06 * (rows.max() - rows.min() + 1)
+    top, bottom = max(0, int(rows.min() - margin)), min(mask.shape[0], int(rows.max() + margin) + 1)
+    left, right = max(0, int(cols.min() - margin)), min(mask.shape[1], int(cols.max() + margin) + 1)
+    scale = PHOTO_HEIGHT_PX / (bottom - top)
+    image = cv2.resize(photo[top:bottom, left:right], None, fx=scale, fy=scale,
+                       interpolation=cv2.INTER_AREA)
+
+    def pixels(points):
+        return np.round((points - [left, top] + 0.5) * scale - 0.5).astype(np.int32)[:, None, :]
+
+    cv2.polylines(image, [pixels(edge)], True, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.polylines(image, [pixels(edge)], True, _MASK_EDGE_BGR, 1, cv2.LINE_AA)
+    drawn = pixels(outline)
+    for i in range(len(drawn)):
+        colour = PART_COLOURS_BGR[matched.body_parts[i]].tolist()
+        cv2.line(image, tuple(drawn[i, 0]), tuple(drawn[(i + 1) % len(drawn), 0]), colour, 2,
+                 cv2.LINE_AA)
+    return _with_legend(image, f"{matched.view}: the photo and the fitted outline",
+                        [(_MASK_EDGE_BGR, "silhouette")])

@@ -21,6 +21,11 @@ __all__ = ["REPORT_PICTURES", "png_data_uri", "report_html"]
 
 #: The pictures a report shows, by key, with their captions.
 REPORT_PICTURES = {
+    "photo_front": "Front: your photo, the silhouette taken of it (white) and the fitted "
+                   "body's outline (photo_front.png)",
+    "photo_side": "Side: your photo, the silhouette taken of it (white) and the fitted "
+                  "body's outline (photo_side.png)",
+    "body_views": "The fitted body from the front, three-quarter and side (body_views.png)",
     "outline_front": "Front: the person's silhouette (grey) with the fitted body's outline",
     "outline_side": "Side: the person's silhouette (grey) with the fitted body's outline",
     "overlay_front": "Front: matched contours (overlay_front.png)",
@@ -137,7 +142,7 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
     """
     inputs, result = record["inputs"], record["result"]
     given = [(name, f"<code>{_e(value)}</code>") for name, value in inputs.items()
-             if value is not None and name not in ("height_cm", "sex")]
+             if value is not None and name not in ("height_cm", "sex", "check")]
     given += [("stature", f"{inputs['height_cm']:g} cm"), ("sex", _e(inputs["sex"]))]
     photos = record.get("photos", {})
     if "camera" in photos:
@@ -146,6 +151,12 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
         given.append(("side photo", f"the person's {_e(photos['side_from'])} side"))
     if "pitch_deg" in photos:
         given.append(("cameras' pitch", pitch_text(photos["pitch_deg"])))
+    if "check_warnings" in photos:
+        given.append(("photography check", "<br>".join(
+            ["passed" + (", with warnings:" if photos["check_warnings"] else "")]
+            + [_e(line) for line in photos["check_warnings"]])))
+    elif inputs.get("check") is False:
+        given.append(("photography check", "skipped (--no-check)"))
     terms = [("total", f"{result['best_cost']:.2f}")]
     terms += [(name, f"{value:.2f}") for name, value in result["part_costs"].items()]
     timings = [(stage, f"{seconds:.2f} s") for stage, seconds in record["timings_s"].items()]
@@ -161,6 +172,14 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
 <p class="note">bodyfit {_e(record["versions"].get("bodyfit", "?"))}, <code>fitter run</code>.
 The measurements are those of the fitted body model; {_e(SPREAD_NOTES[spread_basis])}.</p>
 <table>{_rows(given)}</table>
+
+<h2>Your photos</h2>
+<p class="note">Where the white outline leaves the person, the silhouette is wrong (photograph
+again before a plainer background); where the coloured one leaves the white, the fit is.</p>
+<div class="row">{_figure("photo_front", images)}{_figure("photo_side", images)}</div>
+
+<h2>The fitted body</h2>
+<div class="row">{_figure("body_views", images)}</div>
 
 <h2>Silhouettes</h2>
 <p class="note">The person's silhouette on the fitting canvas (scaled from the stature),

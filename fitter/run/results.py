@@ -12,6 +12,9 @@ Outputs, written atomically into OUT (a failed run leaves OUT as it was):
   cost), the output folder and the working folder (``fitter run --config`` repeats the run);
 - ``overlay_front.png``, ``overlay_side.png``: the person's and the fitted body's
   silhouettes with their matched contour points, coloured by part (the paper's Fig. 6/8);
+- ``photo_front.png``, ``photo_side.png``: the person's own photos with their silhouette's
+  outline and the fitted body's, coloured by part;
+- ``body_views.png``: the fitted body from the front, three-quarter and side, shaded;
 - ``report.html``: one self-contained page of all of it, for a person to read.
 """
 
@@ -27,12 +30,15 @@ from pathlib import Path
 from bodyfit import kernels
 from bodyfit.calib.images import write_image
 from bodyfit.common.errors import UserError
-from bodyfit.fitter.fit.person import PersonInputs
+from bodyfit.fitter.fit.person import PersonInputs, upright_photo
 from bodyfit.fitter.fit.person_fit import Fit, FitSettings, fit_inputs, fit_work
 from bodyfit.fitter.fit.weights import weights_record
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel
+from bodyfit.calib.camera import load_camera
+from bodyfit.fitter.output.body_views import body_views_image
 from bodyfit.fitter.output.mesh_io import write_mesh
-from bodyfit.fitter.output.overlays import fitted_outline_image, match_contours, overlay_image
+from bodyfit.fitter.output.overlays import (fitted_outline_image, match_contours, overlay_image,
+                                            photo_outline_image)
 from bodyfit.fitter.output.plots import line_chart
 from bodyfit.fitter.output.report import report_html
 from bodyfit.fitter.output.result_files import (staged_directory, write_fitted_measurements,
@@ -43,7 +49,7 @@ __all__ = ["RUN_FILES", "check_output_dir", "run_person", "run_record"]
 #: The files every successful run writes into OUT.
 RUN_FILES = ("mesh.obj", "mesh.ply", "mesh_rest.ply", "measurements.json", "measurements.csv",
              "convergence.png", "run.json", "overlay_front.png", "overlay_side.png",
-             "report.html")
+             "photo_front.png", "photo_side.png", "body_views.png", "report.html")
 
 
 def check_output_dir(out_dir: Path, overwrite: bool) -> None:
@@ -132,12 +138,18 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
         write_image(stage / "convergence.png", chart)
         record = run_record(inputs, settings, model, fit, out_dir)
         write_json(stage / "run.json", record)
-        pictures = {"convergence": chart}
+        pictures = {"convergence": chart, "body_views": body_views_image(fit.posed, model.faces)}
+        camera = load_camera(inputs.camera) if inputs.camera else None
         for name, view in fit.views.items():
             matched = match_contours(model, fit.view_bodies[name], view, settings.device)
             pictures[f"overlay_{name}"] = overlay_image(matched)
             pictures[f"outline_{name}"] = fitted_outline_image(matched)
-            write_image(stage / f"overlay_{name}.png", pictures[f"overlay_{name}"])
+            pictures[f"photo_{name}"] = photo_outline_image(
+                matched, upright_photo(getattr(inputs, name), camera), fit.masks[name],
+                mirrored=name == "side" and fit.photos["side_from"] == "right")
+            for kind in ("overlay", "photo"):
+                write_image(stage / f"{kind}_{name}.png", pictures[f"{kind}_{name}"])
+        write_image(stage / "body_views.png", pictures["body_views"])
         write_text(stage / "report.html",
                    report_html(record, fit.measurements, fit.spreads, fit.spread_basis,
                                pictures))

@@ -22,6 +22,8 @@ from bodyfit.fitter.fit.search import SearchSettings
 from bodyfit.fitter.fit.spreads import SPREAD_NOTES, bodyfit_calibration, recorded_answer_cost
 from bodyfit.fitter.measure.measurements import MEASUREMENTS
 from bodyfit.fitter.model.body_model import PART_NAMES
+from bodyfit.fitter.output.body_views import BODY_BGR
+from bodyfit.fitter.output.overlays import _canvas_to_photo
 from bodyfit.fitter.output.render import PART_COLOURS_BGR
 from bodyfit.fitter.run.config import read_run_config, run_config
 from bodyfit.kernels import CostSettings
@@ -78,12 +80,31 @@ def test_overlays_show_both_silhouettes_and_part_coloured_pairs(first_run, view)
     assert (drawing == (212, 212, 212)).all(axis=2).sum() > 100  # the person's silhouette
 
 
+def test_canvas_points_map_into_the_photo_by_the_silhouettes_area_and_centroid():
+    photo, canvas = np.zeros((400, 300), bool), np.zeros((150, 120), bool)
+    photo[100:300, 50:150] = True  # the canvas's person, twice as large, moved
+    canvas[10:110, 20:70] = True
+    mapped = _canvas_to_photo(canvas, photo, np.array([[20.0, 10.0], [69.0, 109.0]]))
+    # each canvas pixel covers two photo pixels a side: the corners' centres land between
+    np.testing.assert_allclose(mapped, [[50.5, 100.5], [148.5, 298.5]])
+
+
+def test_the_body_is_shown_from_three_angles(first_run):
+    image = cv2.imread(str(first_run / "body_views.png"))
+    clay = (np.abs(image.astype(int) - BODY_BGR) < 90).all(axis=2) & (image < 250).any(axis=2)
+    widths = [int(clay[:, cols].any(axis=0).sum()) for cols in
+              np.array_split(np.arange(image.shape[1]), 3)]
+    assert image.shape[0] == 480 + 30
+    assert widths[0] > widths[2] and min(widths) > 40  # the A-pose is wider than its side
+
+
 def test_report_is_one_self_contained_escaped_page(first_run):
     text = (first_run / "report.html").read_text()
     page = _Page()
     page.feed(text)
     page.close()
-    assert len(page.images) == 5  # two outlines, two overlays, convergence
+    # two photos, the body's views, two outlines, two overlays, convergence
+    assert len(page.images) == 8
     assert all(src.startswith("data:image/png;base64,") for src in page.images)
     assert all(url.startswith("data:") for url in page.urls)
     assert "http://" not in text and "https://" not in text and "script" not in page.tags

@@ -1,5 +1,6 @@
 """`fitter run` end to end on synthetic photos, its outputs, and its bad input."""
 
+import dataclasses
 import json
 
 import cv2
@@ -8,7 +9,11 @@ import pytest
 
 from bodyfit.fitter.cli.main import main
 from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.fit.contour import contour_points
+from bodyfit.fitter.fit.person import PersonInputs
+from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
 from bodyfit.fitter.fit.search import SearchSettings
+from bodyfit.fitter.output.overlays import match_contours, outline_in_photo
 from bodyfit.fitter.run.results import RUN_FILES
 
 TRUE_BETAS = np.array([0.8, -0.6, 0.5, 0.3, -0.4] + [0.0] * 15)
@@ -73,6 +78,32 @@ def test_default_fit_measures_the_subject(subject, tmp_path, capsys):
     assert fitted["O"] == pytest.approx(truth["O"], abs=0.2)
     for key in ("D", "E", "F"):
         assert abs(fitted[key] - truth[key]) < 8.0, (key, fitted[key], truth[key])
+
+
+@pytest.mark.parametrize("from_right", [False, True])
+def test_the_fitted_outline_lies_on_the_photos_silhouette(subject, body_model, tmp_path,
+                                                          from_right):
+    """The default fit's outline, moved from the canvas into the photo, runs along the
+    person's silhouette there (the side photo from the right mirrored back)."""
+    folder, truth = subject
+    side = folder / "side.png"
+    if from_right:
+        side = tmp_path / "side_from_right.png"
+        cv2.imwrite(str(side), cv2.imread(str(folder / "side.png"))[:, ::-1])
+    inputs = PersonInputs(str(folder / "front.png"), str(side), truth["O"] / 10)
+    fit = fit_inputs(body_model, inputs, dataclasses.replace(FitSettings(),
+                                                             projection="orthographic"))
+    assert fit.photos["side_from"] == ("right" if from_right else "left")
+    for view in ("front", "side"):
+        mirrored = view == "side" and from_right
+        matched = match_contours(body_model, fit.view_bodies[view], fit.views[view])
+        outline = outline_in_photo(matched, fit.masks[view], mirrored)
+        photo_mask = fit.masks[view][:, ::-1] if mirrored else fit.masks[view]
+        edge = np.ones(photo_mask.shape, np.uint8)
+        edge[tuple(np.round(contour_points(photo_mask)).astype(int)[:, ::-1].T)] = 0
+        distance = cv2.distanceTransform(edge, cv2.DIST_L2, 5)
+        columns, rows = np.round(outline).astype(int).T
+        assert np.median(distance[rows, columns]) < 1.5, view
 
 
 def test_same_seed_same_result(subject, tmp_path, capsys):
