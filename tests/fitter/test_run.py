@@ -228,6 +228,8 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"front twice": True}, r"is (\d\.\d\d) of its height wide and the side one \1: .*the "
                             "person's left or right"),
     ({"arms down": True}, "the side one 0.30: .*the arms held out from the body"),
+    ({"lying down": True}, "the front photo: the person is not upright"),
+    ({"mirror selfie": True}, "the front photo: a hand is raised above the shoulders"),
 ])
 def test_bad_input_is_one_line_exit_2_and_writes_nothing(subject, body_model, tmp_path, capsys,
                                                          change, message):
@@ -239,6 +241,13 @@ def test_bad_input_is_one_line_exit_2_and_writes_nothing(subject, body_model, tm
         args["--side"] = args["--front"]
     if change.pop("arms down", False):  # the arms hanging: 45 degrees below the rest A-pose
         write_subject(tmp_path, body_model, TRUE_BETAS, np.array([-45.0, -45.0, 3.0, 3.0]))
+        args["--front"] = str(tmp_path / "front.png")
+    if change.pop("lying down", False):  # the photo turned on its side
+        front = tmp_path / "lying.png"
+        cv2.imwrite(str(front), np.ascontiguousarray(np.rot90(cv2.imread(args["--front"]))))
+        args["--front"] = str(front)
+    if change.pop("mirror selfie", False):  # the left hand raised to hold a phone up
+        write_subject(tmp_path, body_model, TRUE_BETAS, np.array([110.0, 6.0, 3.0, 3.0]))
         args["--front"] = str(tmp_path / "front.png")
     if change.pop("blank", False):
         blank = tmp_path / "blank.png"
