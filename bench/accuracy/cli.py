@@ -67,7 +67,7 @@ from bench.accuracy.figures import (colour_bar, distance_panel, errors_per_gener
 from bench.accuracy.report import (failure_lines, important_table, measurement_table,
                                    paired_measurement_table)
 from bench.accuracy.runs import concatenated, joined_scores, keep_run, source_timing, subset
-from bench.accuracy.outlines import outline_errors
+from bench.accuracy.outlines import HEIGHT_OFF_SHARE, height_error, outline_errors
 from bench.accuracy.scores import KEYS, RunScores
 from bench.accuracy.subject_set import (BOARD, CAMERA_FILE, SQUARE_MM, SetSettings, read_bodies,
                                         read_settings, subject_ids, write_bodies,
@@ -379,16 +379,18 @@ def figures(args) -> None:
 
 def silhouettes(args) -> None:
     """Markdown: each segmenter's silhouettes of a room set's photos against their truth
-    masks (:func:`.outlines.outline_errors`), and the photos it refused."""
+    masks (:func:`.outlines.outline_errors`), those whose height is off
+    (:func:`.outlines.height_error`), and the photos it refused."""
     folder = Path(args.set)
     with open(folder / "subjects.csv", newline="") as table:
         subjects = [row["id"] for row in csv.DictReader(table)][:args.first]
-    print(f"{folder}, {len(subjects)} subjects: wrong pixels per outline pixel, mean (median)\n")
-    print("| segmenter | view | photos | refused | wrong pixels per outline pixel |")
-    print("|---|---|---|---|---|")
+    print(f"{folder}, {len(subjects)} subjects: wrong pixels per outline pixel, mean "
+          f"(median); the silhouettes whose height is off by over {HEIGHT_OFF_SHARE:.0%}\n")
+    print("| segmenter | view | photos | refused | wrong pixels per outline pixel | height off |")
+    print("|---|---|---|---|---|---|")
     for segmenter in args.segmenter:
         for view in ("front", "side"):
-            wrong, refused = [], 0
+            wrong, off, refused = [], [], 0
             for subject in subjects:
                 truth = cv2.imread(str(folder / subject / f"truth_{view}.png"),
                                    cv2.IMREAD_GRAYSCALE) > 127
@@ -398,8 +400,12 @@ def silhouettes(args) -> None:
                     refused += 1
                     continue
                 wrong.append(outline_errors(mask, truth)[1])
+                error = height_error(mask, truth)
+                if abs(error) > HEIGHT_OFF_SHARE:
+                    off.append(f"{subject} {error:+.1%}")
             shown = f"{np.mean(wrong):.3f} ({np.median(wrong):.3f})" if wrong else "-"
-            print(f"| {segmenter} | {view} | {len(subjects)} | {refused} | {shown} |")
+            print(f"| {segmenter} | {view} | {len(subjects)} | {refused} | {shown} | "
+                  f"{len(off)}{': ' + ', '.join(off) if off else ''} |")
 
 
 def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:

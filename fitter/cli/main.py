@@ -466,8 +466,9 @@ def _cmd_run(args) -> None:
                                   progress=None if not args.quiet else False)
     except ValueError as exc:  # the kernels' argument and device errors, --matching
         raise UserError(str(exc)) from None
-    for line in fit.photos.get("check_warnings", ()):
-        print(f"fitter: warning: {line}", file=sys.stderr)
+    for line in [*fit.photos.get("check_warnings", ()), fit.photos.get("fit_warning")]:
+        if line:
+            print(f"fitter: warning: {line}", file=sys.stderr)
     result = fit.search
     print(f"fitted in {sum(fit.seconds.values()):.1f} s: {fit_work(settings, result)}, "
           f"cost {result.cost:.1f} weighted mm")

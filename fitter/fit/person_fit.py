@@ -29,7 +29,7 @@ from bodyfit.fitter.fit.search import (SearchResult, SearchSettings, averaged, r
                                        searches_together)
 from bodyfit.fitter.fit.side_arms import side_view_options
 from bodyfit.fitter.fit.spreads import (answer_cost, bodyfit_calibration, calibration_applies,
-                                        population_spreads)
+                                        match_warning, population_spreads)
 from bodyfit.fitter.fit.stature import StatureConditioner, stature_scale
 from bodyfit.fitter.fit.weights import cost_settings
 from bodyfit.fitter.measure.measurements import Measurer
@@ -181,8 +181,10 @@ class Fit:
             view's arms down; not rescaled to the stature): what the view's canvas shows.
         photos: what was read of the photos besides their masks (:func:`fit_inputs`):
             ``camera`` (where K came from), ``side_from`` (which side the side photo
-            shows) and, where the photography check ran, ``check_warnings`` (its
-            warnings, one line each); empty for a fit of masks.
+            shows), where the photography check ran ``check_warnings`` (its warnings,
+            one line each), and ``fit_warning`` for a fit that matched its silhouettes
+            poorly (:func:`~bodyfit.fitter.fit.spreads.match_warning`); empty for a fit
+            of masks.
         masks: view name -> (H, W) bool, the silhouettes of the upright photos as fitted
             (:attr:`~bodyfit.fitter.fit.person.PersonPhotos.masks`); empty for a fit of
             masks.
@@ -671,6 +673,9 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
     read = {"camera": photos.camera_source or "orthographic", "side_from": photos.side_from}
     if photos.check is not None:
         read["check_warnings"] = list(photos.check)
+    poor = match_warning(answer_cost(fit.search), fit.spread_basis)
+    if poor is not None:
+        read["fit_warning"] = poor
     if settings.projection == "pinhole":
         read["pitch_deg"] = {name: round(view_pitch_deg(view), 2) + 0.0  # not -0.0
                              for name, view in fit.views.items()}

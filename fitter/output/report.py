@@ -157,6 +157,8 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
             + [_e(line) for line in photos["check_warnings"]])))
     elif inputs.get("check") is False:
         given.append(("photography check", "skipped (--no-check)"))
+    if "fit_warning" in photos:
+        given.append(("fit", f"<strong>{_e(photos['fit_warning'])}</strong>"))
     terms = [("total", f"{result['best_cost']:.2f}")]
     terms += [(name, f"{value:.2f}") for name, value in result["part_costs"].items()]
     timings = [(stage, f"{seconds:.2f} s") for stage, seconds in record["timings_s"].items()]

@@ -9,7 +9,7 @@ import cv2
 import numpy as np
 import pytest
 
-from bench.accuracy.outlines import outline_errors
+from bench.accuracy.outlines import height_error, outline_errors
 from bench.accuracy.rooms import (SHADOW_DEPTH, RoomScene, _room, draw_scene, dressed_colours,
                                   room_photo)
 from bench.accuracy.subject_set import SetSettings, write_bodies, write_photos_of_set
@@ -18,6 +18,17 @@ from bodyfit.calib.silhouette import extract_silhouette
 from bodyfit.fitter.demo.example import demo_camera
 from bodyfit.fitter.demo.studio_photos import pinhole_layers
 from bodyfit.fitter.model.body_model import PART_NAMES
+
+
+def test_height_error_of_a_grown_and_a_cut_silhouette():
+    exact = np.zeros((100, 40), bool)
+    exact[10:90, 10:30] = True  # 80 rows
+    grown, cut = exact.copy(), exact.copy()
+    grown[2:10, 18:22] = True     # a lamp merged above: 88 rows
+    cut[84:90] = False            # the feet lost: 74 rows
+    assert height_error(grown, exact) == pytest.approx(8 / 80)
+    assert height_error(cut, exact) == pytest.approx(-6 / 80)
+    assert height_error(np.roll(exact, 3, axis=0), exact) == 0.0
 
 
 def test_outline_errors_of_a_shifted_and_a_grown_square():

@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 
 from bodyfit.fitter.cli.main import main
-from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.demo.studio_photos import BACKDROP_BGR, write_subject
 from bodyfit.fitter.fit.contour import contour_points
 from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
 from bodyfit.fitter.fit.search import SearchSettings
+from bodyfit.fitter.fit.spreads import POOR_MATCH_COST
 from bodyfit.fitter.output.overlays import match_contours, outline_in_photo
 from bodyfit.fitter.run.results import RUN_FILES
 
@@ -104,6 +105,30 @@ def test_the_fitted_outline_lies_on_the_photos_silhouette(subject, body_model, t
         distance = cv2.distanceTransform(edge, cv2.DIST_L2, 5)
         columns, rows = np.round(outline).astype(int).T
         assert np.median(distance[rows, columns]) < 1.5, view
+
+
+def test_a_silhouette_that_took_in_a_lamp_is_warned_of(subject, tmp_path, capsys):
+    """A dark lamp merged with the head in the side photo (60 px, 8 % of the height) leaves
+    the fit's answer cost over POOR_MATCH_COST: the run warns on stderr, in run.json and
+    in the report, and still writes its outputs; the clean photos are not warned of."""
+    folder, truth = subject
+    side = cv2.copyMakeBorder(cv2.imread(str(folder / "side.png")), 60, 0, 0, 0,
+                              cv2.BORDER_CONSTANT, value=BACKDROP_BGR)
+    rows, cols = np.nonzero(np.abs(side.astype(int) - BACKDROP_BGR).sum(axis=2) > 30)
+    top, centre = rows.min(), int(cols[rows == rows.min()].mean())
+    side[top - 60:top + 4, centre - 20:centre + 20] = (60, 60, 60)
+    cv2.imwrite(str(tmp_path / "side.png"), side)
+    args = person_args(folder, truth)
+    for name, side_photo in (("clean", folder / "side.png"), ("lamp", tmp_path / "side.png")):
+        args[args.index("--side") + 1] = str(side_photo)
+        code, _, err = run(capsys, "run", *args, "-o", str(tmp_path / name))
+        assert code == 0, err
+        record = json.loads((tmp_path / name / "run.json").read_text())
+        warned = "matches the silhouettes poorly" in err
+        assert warned == (name == "lamp") == ("fit_warning" in record["photos"])
+        assert warned == (record["result"]["best_cost"] > POOR_MATCH_COST)
+        assert warned == ("matches the silhouettes poorly"
+                          in (tmp_path / name / "report.html").read_text())
 
 
 def test_same_seed_same_result(subject, tmp_path, capsys):
