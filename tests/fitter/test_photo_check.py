@@ -163,3 +163,13 @@ def test_no_check_reaches_a_run_and_every_batch_subject(tmp_path):
         batch = _build_parser().parse_args(["batch", "t.csv", "-o", str(tmp_path), *extra])
         row = SubjectRow("s1", PersonInputs("front.png", "side.png", 175.0), None, 2)
         assert subject_job(row, METHODS["bodyfit"], vars(batch), tmp_path).inputs.check is check
+
+
+def test_two_bodies_side_by_side_are_two_people(front, side, tmp_path, capsys):
+    """Two of the part-coloured bodies side by side, which the detector scores under
+    SECOND_PERSON_SCORE each: the second counts by its share of the first's score."""
+    write_image(tmp_path / "two.png", np.hstack([front, front]))
+    write_image(tmp_path / "side.png", side)
+    assert main(["check", str(tmp_path / "two.png"), str(tmp_path / "side.png")]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "fitter: error: 2 people found in the photo; photograph one person at a time")
