@@ -11,17 +11,20 @@ package pulls in a GUI build of OpenCV:
 
 1. **Detection** (``pose_detection.tflite``): the photo letterboxed to a square (grey
    padding, the detector's zero) at 224 x 224; 2254 SSD anchors each give a box, four
-   keypoints and a score. The best box above ``DETECTION_SCORE`` is the person; its
-   neighbours (box IoU over ``NMS_IOU``) are averaged into its keypoints, weighted by
-   score. Other boxes apart from it scoring at least ``SECOND_PERSON_SCORE``, or at
-   least ``DETECTION_SCORE`` and ``SECOND_PERSON_SHARE`` of its score, are more people,
-   counted by OpenCV's non-maximum suppression.
-2. **Region**: a square about keypoint 0 (the hips' centre), its side twice the distance
+   keypoints and a score. The boxes above ``DETECTION_SCORE``, grouped by OpenCV's
+   non-maximum suppression, are the candidates (``CANDIDATES`` at most, best first); each
+   group's boxes (box IoU over ``NMS_IOU`` with its best) are averaged into its
+   keypoints, weighted by score.
+2. **Region** of each candidate: a square about keypoint 0 (the hips' centre), its side twice the distance
    to keypoint 1 (a point above the head) times ``REGION_SCALE``, turned so that this
    direction points up.
 3. **Landmarks and mask** (``pose_landmark_full.tflite``, the region at 256 x 256): 33
    landmarks, refined by the model's heatmaps (``HEATMAP_KERNEL``), and a person
-   probability over the region, both mapped back into the photo.
+   probability over the region, both mapped back into the photo, with the model's own
+   flag of whether a person is there. The person is the best-scored candidate the flag
+   passes (in a room photo the detector's best box was once an armchair's, 0.55 against
+   the person's 0.51); another it passes that scores at least ``SECOND_PERSON_SCORE``,
+   or ``SECOND_PERSON_SHARE`` of the person's score, is a second person.
 
 Units: pixels of the photo as given (x right, y down). The detector's grey padding
 instead of MediaPipe's black raised a side photo's score from 0.18 to 0.62; masks agree
@@ -45,14 +48,17 @@ __all__ = ["DETECTION_SCORE", "SECOND_PERSON_SCORE", "SECOND_PERSON_SHARE", "NoP
 
 #: A detection's least score (after the sigmoid) to count as a person.
 DETECTION_SCORE = 0.5
-#: A box apart from the best one with at least this score is a second person (rooms hold
-#: faces in pictures, cushions and the like that score 0.5-0.6).
+#: Another candidate the landmark model takes for a person is a second person when it
+#: scores at least this (rooms hold faces in pictures, cushions and the like that score
+#: 0.5-0.6) ...
 SECOND_PERSON_SCORE = 0.8
-#: ... as is one scoring at least ``DETECTION_SCORE`` and this share of the best one's: two
-#: of the demo's part-coloured bodies side by side score 0.69 and 0.59 (0.84 of it),
-#: where the room and plain benchmark photos' and the real photos' next best boxes reach
-#: 0.67 of their person's at most (192 benchmark photos and the real photos).
+#: ... or this share of the person's score: two of the demo's part-coloured bodies side
+#: by side score 0.69 and 0.59 (0.84 of it), where the benchmark's room and plain photos'
+#: and the real photos' next best boxes reach 0.67 of their best's at most (192 benchmark
+#: photos and the real photos).
 SECOND_PERSON_SHARE = 0.75
+#: The detections (groups of boxes) the landmark model looks at, best first.
+CANDIDATES = 3
 #: Boxes overlapping the best one by more than this IoU are the same person.
 NMS_IOU = 0.3
 #: The region's side over twice the hips-to-head distance (MediaPipe's 1.25).
@@ -143,11 +149,15 @@ class PersonSegmenter:
         outputs = sorted(interpreter.get_output_details(), key=lambda d: d["name"])
         return [interpreter.get_tensor(d["index"])[0] for d in outputs]
 
-    def _detect(self, rgb: np.ndarray) -> tuple[np.ndarray, float]:
-        """((2, 2) keypoints 0 and 1 in photo pixels, score) of the one person.
+    def _detections(self, rgb: np.ndarray) -> list[tuple[np.ndarray, float]]:
+        """[((2, 2) keypoints 0 and 1 in photo pixels, score)] of up to ``CANDIDATES``
+        people the detector may have found, best first: its boxes scoring at least
+        ``DETECTION_SCORE``, grouped by OpenCV's non-maximum suppression, each group's
+        keypoints averaged over its boxes (box IoU over ``NMS_IOU`` with its best one),
+        weighted by score.
 
         Raises:
-            UserError: no person, or more than one.
+            NoPersonFound: no box scores ``DETECTION_SCORE``.
         """
         height, width = rgb.shape[:2]
         side = max(height, width)
@@ -159,35 +169,28 @@ class PersonSegmenter:
                             interpolation=cv2.INTER_AREA).astype(np.float32) / 127.5 - 1
         boxes, logits = self._run(self._detector, tensor)
         score = _sigmoid(logits[:, 0])
-        best = int(np.argmax(score))
-        if score[best] < DETECTION_SCORE:
+        found = np.flatnonzero(score >= DETECTION_SCORE)
+        if not len(found):
             raise NoPersonFound()
         size = boxes[:, 2:4] / _DETECTOR_SIDE
         centre = boxes[:, :2] / _DETECTOR_SIDE + self._anchors
         lo, hi = centre - size / 2, centre + size / 2
-        same = _box_iou(lo, hi, best) > NMS_IOU
-        second = (score >= SECOND_PERSON_SCORE) | (
-            (score >= DETECTION_SCORE) & (score >= SECOND_PERSON_SHARE * score[best]))
-        others = np.flatnonzero(second & ~same)
-        if len(others):
-            apart = cv2.dnn.NMSBoxes(np.hstack([lo, hi - lo])[others].tolist(),
-                                     score[others].tolist(), DETECTION_SCORE, NMS_IOU)
-            raise UserError(f"{1 + len(apart)} people found in the photo; photograph one "
-                            "person at a time")
-        weight = score * (same & (score >= DETECTION_SCORE))
         keypoints = boxes[:, 4:8].reshape(-1, 2, 2) / _DETECTOR_SIDE + self._anchors[:, None]
-        keypoints = (keypoints * weight[:, None, None]).sum(0) / weight.sum()
-        return keypoints * side - [pad_x, pad_y], float(score[best])
+        groups = cv2.dnn.NMSBoxes(np.hstack([lo, hi - lo])[found].tolist(),
+                                  score[found].tolist(), DETECTION_SCORE, NMS_IOU)
+        people = []
+        for best in found[np.asarray(groups, int).ravel()][:CANDIDATES]:
+            weight = score * ((_box_iou(lo, hi, best) > NMS_IOU) & (score >= DETECTION_SCORE))
+            averaged = (keypoints * weight[:, None, None]).sum(0) / weight.sum()
+            people.append((averaged * side - [pad_x, pad_y], float(score[best])))
+        return people
 
-    def __call__(self, image_bgr: np.ndarray) -> PersonFound:
-        """The person in an (H, W, 3) uint8 BGR photo.
-
-        Raises:
-            UserError: no person, or more than one.
-        """
-        rgb = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2RGB)
+    def _person_at(self, rgb: np.ndarray, keypoints: np.ndarray, score: float
+                   ) -> PersonFound | None:
+        """The landmark model's person in the region of a detection's ``keypoints``
+        (hips' centre, above the head), or None where it says no person is there."""
         height, width = rgb.shape[:2]
-        (hips, head), score = self._detect(rgb)
+        hips, head = keypoints
         side = 2 * np.linalg.norm(head - hips) * REGION_SCALE
         angle = np.pi / 2 - np.arctan2(-(head[1] - hips[1]), head[0] - hips[0])
         turn = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
@@ -200,7 +203,7 @@ class PersonSegmenter:
         raw, flag, mask_logits, heatmaps, _ = self._run(self._landmarker,
                                                         crop.astype(np.float32) / 255)
         if float(flag[0]) < DETECTION_SCORE:
-            raise NoPersonFound()
+            return None
         landmarks = _refined(raw.reshape(-1, 5)[:_LANDMARKS].copy(), heatmaps)
         xy = landmarks[:, :2] @ to_photo[:, :2].T + to_photo[:, 2]
         landmarks = np.column_stack([xy, landmarks[:, 2] * side / _LANDMARK_SIDE,
@@ -209,6 +212,29 @@ class PersonSegmenter:
                                      to_photo, (width, height), flags=cv2.INTER_LINEAR,
                                      borderMode=cv2.BORDER_CONSTANT, borderValue=0)
         return PersonFound(probability, landmarks, score)
+
+    def __call__(self, image_bgr: np.ndarray) -> PersonFound:
+        """The person in an (H, W, 3) uint8 BGR photo: the best-scored detection whose
+        region the landmark model takes for a person.
+
+        Raises:
+            NoPersonFound: no detection the landmark model takes for a person.
+            UserError: another such detection, scoring at least ``SECOND_PERSON_SCORE``
+                or ``SECOND_PERSON_SHARE`` of the person's score.
+        """
+        rgb = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2RGB)
+        people = [found for found in (self._person_at(rgb, keypoints, score)
+                                      for keypoints, score in self._detections(rgb))
+                  if found is not None]
+        if not people:
+            raise NoPersonFound()
+        person = people[0]
+        others = [other for other in people[1:] if other.score >= min(
+            SECOND_PERSON_SCORE, SECOND_PERSON_SHARE * person.score)]
+        if others:
+            raise UserError(f"{1 + len(others)} people found in the photo; photograph one "
+                            "person at a time")
+        return person
 
 
 def _refined(landmarks: np.ndarray, heatmaps: np.ndarray) -> np.ndarray:

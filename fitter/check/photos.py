@@ -105,8 +105,8 @@ class ViewVerdict:
             vertical), ``ankles`` (their span across, a share of the height),
             ``shoulders`` (their span over the torso's length), ``arm_deg``
             (front: the arm nearer the body, degrees out from the torso's side; side: the
-            arm farther from vertical) and ``hand_raised`` (1.0 when a wrist is above the
-            shoulders).
+            arm nearer the camera, degrees from vertical) and ``hand_raised`` (1.0 when a
+            wrist is above the shoulders; a side photo's nearer one).
         problems: one line each, saying what to do; any of them stops a fit.
         warnings: one line each; the fit goes on.
     """
@@ -148,22 +148,27 @@ def _angle_deg(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def _landmark_readings(view: str, landmarks: np.ndarray, height_px: int) -> dict[str, float]:
-    """:attr:`ViewVerdict.readings` of the landmarks ((33, 2+) pixels; ``height_px``: the
-    silhouette's height)."""
+    """:attr:`ViewVerdict.readings` of the landmarks ((33, 5): x, y pixels, z depth;
+    ``height_px``: the silhouette's height). A side photo's arm rules read the arm nearer
+    the camera only (its shoulder's z the smaller): the model guesses the hidden arm, and
+    laid one along a table's edge at shoulder height with a visibility of 0.8."""
     xy = landmarks[:, :2].astype(np.float64)
     shoulders, hips = xy[list(_SHOULDERS)].mean(0), xy[list(_HIPS)].mean(0)
+    arms = list(zip(_SHOULDERS, _WRISTS, _HIPS))
     if view == "front":
         arm_deg = min(_angle_deg(xy[wrist] - xy[shoulder], xy[hip] - xy[shoulder])
-                      for shoulder, wrist, hip in zip(_SHOULDERS, _WRISTS, _HIPS))
+                      for shoulder, wrist, hip in arms)
     else:
+        arms = [arms[int(np.argmin(landmarks[list(_SHOULDERS), 2]))]]
         arm_deg = max(_angle_deg(xy[wrist] - xy[shoulder], np.array([0.0, 1.0]))
-                      for shoulder, wrist in zip(_SHOULDERS, _WRISTS))
+                      for shoulder, wrist, _ in arms)
+    wrists = [wrist for _, wrist, _ in arms]
     return {"lean_deg": _angle_deg(shoulders - xy[list(_ANKLES)].mean(0), np.array([0.0, -1.0])),
             "ankles": abs(xy[_ANKLES[0], 0] - xy[_ANKLES[1], 0]) / height_px,
             "shoulders": abs(xy[_SHOULDERS[0], 0] - xy[_SHOULDERS[1], 0])
                          / max(np.linalg.norm(hips - shoulders), 1.0),
             "arm_deg": arm_deg,
-            "hand_raised": float((xy[list(_WRISTS), 1] < shoulders[1]).any())}
+            "hand_raised": float((xy[wrists, 1] < shoulders[1]).any())}
 
 
 def _framing(view: str, shape: SilhouetteShape, horizon: float) -> list[str]:
