@@ -15,9 +15,9 @@ package pulls in a GUI build of OpenCV:
    non-maximum suppression, are the candidates (``CANDIDATES`` at most, best first); each
    group's boxes (box IoU over ``NMS_IOU`` with its best) are averaged into its
    keypoints, weighted by score.
-2. **Region** of each candidate: a square about keypoint 0 (the hips' centre), its side twice the distance
-   to keypoint 1 (a point above the head) times ``REGION_SCALE``, turned so that this
-   direction points up.
+2. **Region** of each candidate: a square about keypoint 0 (the hips' centre), its side
+   twice the distance to keypoint 1 (a point above the head) times ``REGION_SCALE``,
+   turned so that this direction points up.
 3. **Landmarks and mask** (``pose_landmark_full.tflite``, the region at 256 x 256): 33
    landmarks, refined by the model's heatmaps (``HEATMAP_KERNEL``), and a person
    probability over the region, both mapped back into the photo, with the model's own

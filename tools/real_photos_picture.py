@@ -4,7 +4,8 @@ check's verdict, for docs/real-photos.md.
 For each photo: the silhouette `calib silhouette` and `fitter run` take of it (the
 ``auto`` segmenter) tinted over it with its outline, the pose model's landmarks as dots,
 written as a JPEG 480 px tall; and one Markdown table row: the photo, the picture, the
-check's reading and its verdict as a front photo (problems, then warnings). A photo with no person gets the line the silhouette step refuses it with.
+check's reading and its verdict as a front photo (problems, then warnings). A photo with
+no person gets the line the silhouette step refuses it with.
 Usage:
 
     python tools/real_photos_picture.py [--photos tests/data/real-photos] [-o docs/real-photos]

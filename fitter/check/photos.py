@@ -61,9 +61,10 @@ from bodyfit.calib.segment import NoPersonFound, person_segmenter
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.check.shape import SilhouetteShape, silhouette_shape
 
-__all__ = ["FACING_SHARE", "HORIZON_RANGE", "MAX_LEAN_DEG", "MAX_SIDE_ARM_DEG", "MIN_ARM_DEG",
-           "MIN_ANKLES_APART", "MIN_ARM_GAP", "MIN_FEET_GAP", "MIN_HEIGHT_PX", "MIN_LEG_SPLIT", "MIN_MARGIN",
-           "SIDE_SHARE", "PhotoCheckFailed", "ViewVerdict", "check_view", "failed_lines"]
+__all__ = ["FACING_SHARE", "HORIZON_RANGE", "MAX_LEAN_DEG", "MAX_SIDE_ARM_DEG", "MIN_ANKLES_APART",
+           "MIN_ARM_DEG", "MIN_ARM_GAP", "MIN_FEET_GAP", "MIN_HEIGHT_PX", "MIN_LEG_SPLIT",
+           "MIN_MARGIN", "SIDE_SHARE", "PhotoCheckFailed", "ViewVerdict", "check_view",
+           "failed_lines"]
 
 MIN_HEIGHT_PX = 400
 MIN_MARGIN = 0.01
