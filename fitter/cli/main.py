@@ -250,7 +250,9 @@ def _build_parser() -> argparse.ArgumentParser:
         "run", help="fit the body model to a person's front and side photos: mesh (m), "
                     "16 measurements (mm), convergence plot, run record",
         description="Fit bodyfit's body model to a front photo (A-pose) and a side photo "
-                    "(arms hanging down) on a plain backdrop. Cameras: with --camera, "
+                    "(arms hanging down) on a plain backdrop or in a room (--segmenter), "
+                    "after the photography check (fitter check; --no-check skips it). "
+                    "Cameras: with --camera, "
                     "the calibrated pinhole camera, the person's distance solved from the "
                     "stature; without, see --projection (docs/fitter.md, Cameras).")
     _add_fit_options(run, batch=False)
