@@ -223,16 +223,19 @@ class PersonSegmenter:
                 or ``SECOND_PERSON_SHARE`` of the person's score.
         """
         rgb = cv2.cvtColor(image_bgr, cv2.COLOR_BGR2RGB)
-        people = [found for found in (self._person_at(rgb, keypoints, score)
-                                      for keypoints, score in self._detections(rgb))
-                  if found is not None]
-        if not people:
+        person, others = None, 0
+        for keypoints, score in self._detections(rgb):  # best first
+            if person is not None and score < min(SECOND_PERSON_SCORE,
+                                                  SECOND_PERSON_SHARE * person.score):
+                break  # this one and those after it score too low to be a second person
+            found = self._person_at(rgb, keypoints, score)
+            if found is not None:
+                others += person is not None
+                person = person or found
+        if person is None:
             raise NoPersonFound()
-        person = people[0]
-        others = [other for other in people[1:] if other.score >= min(
-            SECOND_PERSON_SCORE, SECOND_PERSON_SHARE * person.score)]
         if others:
-            raise UserError(f"{1 + len(others)} people found in the photo; photograph one "
+            raise UserError(f"{1 + others} people found in the photo; photograph one "
                             "person at a time")
         return person
 
