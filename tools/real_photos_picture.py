@@ -19,11 +19,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from bodyfit.calib.images import read_photo, to_upright, write_image
-from bodyfit.calib.segment import person_segmenter
-from bodyfit.calib.silhouette import SilhouetteSettings, extract_silhouette
+from bodyfit.calib.images import write_image
+from bodyfit.calib.silhouette import photo_silhouette
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.check.photos import check_view
+from bodyfit.fitter.fit.person import upright_photo
 
 HEIGHT_PX = 480
 _TINT_BGR = np.array([60, 200, 60], np.float64)
@@ -49,18 +49,15 @@ def _picture(image: np.ndarray, mask: np.ndarray, landmarks: np.ndarray | None) 
 
 def photo_row(path: Path, out_dir: Path) -> str:
     """Write ``out_dir/<name>.jpg`` of one photo; return its Markdown table row."""
-    photo = read_photo(path)
-    image = to_upright(photo.pixels, photo.orientation)
+    image = upright_photo(str(path), None)
     try:
-        mask = to_upright(extract_silhouette(photo.pixels, None, SilhouetteSettings(), "auto")
-                          .view(np.uint8), photo.orientation).astype(bool)
+        mask = photo_silhouette(path)
     except UserError as error:
         write_image(out_dir / f"{path.stem}.jpg", _picture(image, np.zeros(image.shape[:2], bool),
                                                            None))
         return f"| {path.name} | ![{path.stem}](real-photos/{path.stem}.jpg) | refused: {error} |"
     verdict = check_view("front", image, mask)
-    landmarks = person_segmenter()(image).landmarks if verdict.posed else None
-    write_image(out_dir / f"{path.stem}.jpg", _picture(image, mask, landmarks))
+    write_image(out_dir / f"{path.stem}.jpg", _picture(image, mask, verdict.landmarks))
     said = ([f"**problem**: {line}" for line in verdict.problems]
             + [f"warning: {line}" for line in verdict.warnings]) or ["passes"]
     return (f"| {path.name} | ![{path.stem}](real-photos/{path.stem}.jpg) | "

@@ -108,6 +108,9 @@ class ViewVerdict:
             (front: the arm nearer the body, degrees out from the torso's side; side: the
             arm nearer the camera, degrees from vertical) and ``hand_raised`` (1.0 when a
             wrist is above the shoulders; a side photo's nearer one).
+        landmarks: (33, 5) the pose model's landmarks
+            (:attr:`bodyfit.calib.segment.PersonFound.landmarks`), or None where it found
+            no one (the silhouette's rules only).
         problems: one line each, saying what to do; any of them stops a fit.
         warnings: one line each; the fit goes on.
     """
@@ -115,13 +118,9 @@ class ViewVerdict:
     view: str
     shape: SilhouetteShape
     readings: dict[str, float]
+    landmarks: np.ndarray | None
     problems: tuple[str, ...]
     warnings: tuple[str, ...]
-
-    @property
-    def posed(self) -> bool:
-        """Whether the pose model found the person (its rules were applied)."""
-        return "lean_deg" in self.readings
 
     def summary(self) -> str:
         """One line of what was read, for people."""
@@ -132,7 +131,7 @@ class ViewVerdict:
             parts += [f"feet {shape.feet_gap:.0%} of the height apart",
                       f"legs parting {shape.leg_split:.0%} up",
                       f"arms clear of the torso by {min(shape.arm_gaps):.0%}"]
-        if self.posed:
+        if self.landmarks is not None:
             arms = "out from the torso" if self.view == "front" else "from vertical"
             parts += [f"shoulders {read['shoulders']:.2f} of the torso apart",
                       f"arm {read['arm_deg']:.0f} degrees {arms}"]
@@ -235,14 +234,15 @@ def check_view(view: str, image: np.ndarray, mask: np.ndarray) -> ViewVerdict:
     soles = mask.shape[0] - shape.margins[1] * shape.height_px  # the soles' row + 1
     readings = {"horizon": (soles - mask.shape[0] / 2) / shape.height_px}
     try:
-        readings |= _landmark_readings(view, person_segmenter()(image).landmarks,
-                                       shape.height_px)
+        landmarks = person_segmenter()(image).landmarks
     except NoPersonFound:
-        pass  # the silhouette's rules only
+        landmarks = None  # the silhouette's rules only
+    if landmarks is not None:
+        readings |= _landmark_readings(view, landmarks, shape.height_px)
     if shape.width_px > shape.height_px or readings.get("lean_deg", 0.0) > MAX_LEAN_DEG:
-        return ViewVerdict(view, shape, readings, (_not_upright(view),), ())
+        return ViewVerdict(view, shape, readings, landmarks, (_not_upright(view),), ())
     problems = _framing(view, shape, readings["horizon"])
-    if "lean_deg" in readings:
+    if landmarks is not None:
         problems += _posture(view, readings, shape)
     warnings = []
     if view == "front":
@@ -254,7 +254,7 @@ def check_view(view: str, image: np.ndarray, mask: np.ndarray) -> ViewVerdict:
                             "height above the soles (bare or fitted legs: about 45 %); a long "
                             "top, a skirt or a dress hides the hips and thighs, so wear fitted "
                             "clothes")
-    return ViewVerdict(view, shape, readings, tuple(problems), tuple(warnings))
+    return ViewVerdict(view, shape, readings, landmarks, tuple(problems), tuple(warnings))
 
 
 def failed_lines(verdicts: list[ViewVerdict]) -> list[str]:

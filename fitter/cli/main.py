@@ -485,6 +485,7 @@ def _cmd_run(args) -> None:
 
 
 def _cmd_check(args) -> int:
+    from bodyfit.fitter.check.photos import failed_lines
     from bodyfit.fitter.fit.person import PersonInputs, checked_photos
 
     inputs = PersonInputs(args.front, args.side, float("nan"),  # the check reads no stature
@@ -496,7 +497,7 @@ def _cmd_check(args) -> int:
         print(verdict.summary())
         for line in verdict.warnings:
             print(f"fitter: warning: {line}", file=sys.stderr)
-    problems = [line for verdict in verdicts for line in verdict.problems]
+    problems = failed_lines(verdicts)
     for line in problems:
         print(f"fitter: error: {line}", file=sys.stderr)
     if problems:

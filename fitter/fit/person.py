@@ -245,8 +245,9 @@ def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
     warnings = None
     if inputs.check:
         verdicts = checked_photos(inputs, masks)
-        if failed_lines(verdicts):
-            raise PhotoCheckFailed("\n".join(failed_lines(verdicts)))
+        problems = failed_lines(verdicts)
+        if problems:
+            raise PhotoCheckFailed("\n".join(problems))
         warnings = tuple(line for verdict in verdicts for line in verdict.warnings)
     intrinsics, source = (view_intrinsics(inputs, masks) if projection == "pinhole"
                           else (None, ""))
