@@ -146,6 +146,15 @@ def _cropped(image: np.ndarray, margin_px: int = 16) -> np.ndarray:
     return image[top:rows.max() + margin_px + 1, left:cols.max() + margin_px + 1]
 
 
+def _draw_part_outline(image: np.ndarray, outline: np.ndarray, parts: np.ndarray) -> None:
+    """Draw the closed ``outline`` ((N, 1, 2) int32 pixels) on ``image``, each segment 2 px
+    wide in the colour of its first point's part (``parts``: (N,) ``PART_NAMES`` indices)."""
+    for i in range(len(outline)):
+        colour = PART_COLOURS_BGR[parts[i]].tolist()
+        cv2.line(image, tuple(outline[i, 0]), tuple(outline[(i + 1) % len(outline), 0]), colour,
+                 2, cv2.LINE_AA)
+
+
 def _with_legend(image: np.ndarray, title: str, entries: list[tuple[tuple, str]]) -> np.ndarray:
     """``image``, cropped, under a title band, with the parts legend and ``entries`` to
     its right."""
@@ -193,11 +202,7 @@ def fitted_outline_image(matched: MatchedContours) -> np.ndarray:
     big = cv2.resize(matched.silhouette.astype(np.uint8), image.shape[1::-1],
                      interpolation=cv2.INTER_NEAREST).astype(bool)
     image[big] = (110, 110, 110)
-    outline = _px(matched.body_on_person(matched.body))
-    for i in range(len(outline)):
-        j = (i + 1) % len(outline)
-        colour = PART_COLOURS_BGR[matched.body_parts[i]].tolist()
-        cv2.line(image, tuple(outline[i, 0]), tuple(outline[j, 0]), colour, 2, cv2.LINE_AA)
+    _draw_part_outline(image, _px(matched.body_on_person(matched.body)), matched.body_parts)
     return _with_legend(image, f"{matched.view}: person and fitted outline",
                         [((110, 110, 110), "person")])
 
@@ -261,10 +266,6 @@ def photo_outline_image(matched: MatchedContours, photo: np.ndarray, mask: np.nd
 
     cv2.polylines(image, [pixels(edge)], True, (0, 0, 0), 3, cv2.LINE_AA)
     cv2.polylines(image, [pixels(edge)], True, _MASK_EDGE_BGR, 1, cv2.LINE_AA)
-    drawn = pixels(outline)
-    for i in range(len(drawn)):
-        colour = PART_COLOURS_BGR[matched.body_parts[i]].tolist()
-        cv2.line(image, tuple(drawn[i, 0]), tuple(drawn[(i + 1) % len(drawn), 0]), colour, 2,
-                 cv2.LINE_AA)
+    _draw_part_outline(image, pixels(outline), matched.body_parts)
     return _with_legend(image, f"{matched.view}: the photo and the fitted outline",
                         [(_MASK_EDGE_BGR, "silhouette")])

@@ -28,13 +28,13 @@ from pathlib import Path
 
 
 from bodyfit import kernels
+from bodyfit.calib.camera import load_camera
 from bodyfit.calib.images import write_image
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.person import PersonInputs, upright_photo
 from bodyfit.fitter.fit.person_fit import Fit, FitSettings, fit_inputs, fit_work
 from bodyfit.fitter.fit.weights import weights_record
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel
-from bodyfit.calib.camera import load_camera
 from bodyfit.fitter.output.body_views import body_views_image
 from bodyfit.fitter.output.mesh_io import write_mesh
 from bodyfit.fitter.output.overlays import (fitted_outline_image, match_contours, overlay_image,
