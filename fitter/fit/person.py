@@ -120,12 +120,17 @@ def upright_photo(path: str, camera) -> np.ndarray:
     return to_upright(pixels, photo.orientation)
 
 
-def checked_photos(inputs: PersonInputs, masks: dict[str, np.ndarray] | None = None
-                   ) -> list[ViewVerdict]:
+def _upright_photos(inputs: PersonInputs, camera) -> dict[str, np.ndarray]:
+    return {view: upright_photo(getattr(inputs, view), camera) for view in ("front", "side")}
+
+
+def checked_photos(inputs: PersonInputs, masks: dict[str, np.ndarray] | None = None,
+                   photos: dict[str, np.ndarray] | None = None) -> list[ViewVerdict]:
     """The photography check of the person's photos, front then side
     (:func:`bodyfit.fitter.check.photos.check_view`), on ``masks`` (default: their
-    silhouettes, without :func:`person_masks`' own refusals). Of ``inputs`` it reads the
-    photos, masks, background plates, camera and segmenter only.
+    silhouettes, without :func:`person_masks`' own refusals) and ``photos`` (default:
+    :func:`upright_photo` of each). Of ``inputs`` it reads the photos, masks, background
+    plates, camera and segmenter only.
 
     Raises:
         UserError: unreadable files, no person, several people, a person cut by the frame.
@@ -133,8 +138,8 @@ def checked_photos(inputs: PersonInputs, masks: dict[str, np.ndarray] | None = N
     inputs.validate_photos()
     camera = load_camera(inputs.camera) if inputs.camera else None
     masks = masks or _masks(inputs, camera)
-    return [check_view(view, upright_photo(getattr(inputs, view), camera), masks[view])
-            for view in ("front", "side")]
+    photos = photos or _upright_photos(inputs, camera)
+    return [check_view(view, photos[view], masks[view]) for view in ("front", "side")]
 
 
 def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
@@ -220,13 +225,16 @@ class PersonPhotos:
         side_from: which side of the person the side photo shows: "left", "right", or
             "left (assumed)" when the feet do not tell.
         check: the photography check's warnings, one line each; None where it was not run.
+        images: view name -> (H, W, 3) uint8 BGR, the photos undistorted and upright
+            (:func:`upright_photo`), as taken (the side one not mirrored).
     """
 
     masks: dict[str, np.ndarray]
     intrinsics: dict[str, np.ndarray] | None
     camera_source: str
     side_from: str
-    check: tuple[str, ...] | None = None
+    check: tuple[str, ...] | None
+    images: dict[str, np.ndarray]
 
 
 def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
@@ -242,9 +250,10 @@ def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
             refusals, each a single line that names the problem of the pair).
     """
     masks = person_masks(inputs)
+    images = _upright_photos(inputs, load_camera(inputs.camera) if inputs.camera else None)
     warnings = None
     if inputs.check:
-        verdicts = checked_photos(inputs, masks)
+        verdicts = checked_photos(inputs, masks, images)
         problems = failed_lines(verdicts)
         if problems:
             raise PhotoCheckFailed("\n".join(problems))
@@ -258,4 +267,4 @@ def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
             mirrored = intrinsics["side"].copy()
             mirrored[0, 2] = masks["side"].shape[1] - 1 - mirrored[0, 2]
             intrinsics = intrinsics | {"side": mirrored}
-    return PersonPhotos(masks, intrinsics, source, seen or "left (assumed)", warnings)
+    return PersonPhotos(masks, intrinsics, source, seen or "left (assumed)", warnings, images)

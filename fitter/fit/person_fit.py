@@ -188,6 +188,9 @@ class Fit:
         masks: view name -> (H, W) bool, the silhouettes of the upright photos as fitted
             (:attr:`~bodyfit.fitter.fit.person.PersonPhotos.masks`); empty for a fit of
             masks.
+        images: view name -> (H, W, 3) uint8 BGR, the photos undistorted and upright, as
+            taken (:attr:`~bodyfit.fitter.fit.person.PersonPhotos.images`); empty for a
+            fit of masks.
     """
 
     search: SearchResult
@@ -201,6 +204,7 @@ class Fit:
     view_bodies: dict[str, np.ndarray]
     photos: dict[str, object] = dataclasses.field(default_factory=dict)
     masks: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    images: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
 
 
 def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
@@ -679,4 +683,4 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
     if settings.projection == "pinhole":
         read["pitch_deg"] = {name: round(view_pitch_deg(view), 2) + 0.0  # not -0.0
                              for name, view in fit.views.items()}
-    return dataclasses.replace(fit, photos=read, masks=photos.masks)
+    return dataclasses.replace(fit, photos=read, masks=photos.masks, images=photos.images)

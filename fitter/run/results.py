@@ -28,10 +28,9 @@ from pathlib import Path
 
 
 from bodyfit import kernels
-from bodyfit.calib.camera import load_camera
 from bodyfit.calib.images import write_image
 from bodyfit.common.errors import UserError
-from bodyfit.fitter.fit.person import PersonInputs, upright_photo
+from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import Fit, FitSettings, fit_inputs, fit_work
 from bodyfit.fitter.fit.weights import weights_record
 from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel
@@ -139,13 +138,12 @@ def run_person(model: BodyModel, inputs: PersonInputs, settings: FitSettings, ou
         record = run_record(inputs, settings, model, fit, out_dir)
         write_json(stage / "run.json", record)
         pictures = {"convergence": chart, "body_views": body_views_image(fit.posed, model.faces)}
-        camera = load_camera(inputs.camera) if inputs.camera else None
         for name, view in fit.views.items():
             matched = match_contours(model, fit.view_bodies[name], view, settings.device)
             pictures[f"overlay_{name}"] = overlay_image(matched)
             pictures[f"outline_{name}"] = fitted_outline_image(matched)
             pictures[f"photo_{name}"] = photo_outline_image(
-                matched, upright_photo(getattr(inputs, name), camera), fit.masks[name],
+                matched, fit.images[name], fit.masks[name],
                 mirrored=name == "side" and fit.photos["side_from"] == "right")
             for kind in ("overlay", "photo"):
                 write_image(stage / f"{kind}_{name}.png", pictures[f"{kind}_{name}"])
