@@ -55,7 +55,14 @@ others as large beside it, as a room's floor or door frames give):
 2. OpenCV's GrabCut from that region (colour models of the person and the room, the cut
    drawn along the photo's edges): person for sure ``grabcut_inside_px`` inside its
    outline, room ``grabcut_outside_px`` outside, either between (on the room benchmark
-   the wrong pixels per outline pixel 1.40 -> 1.06, docs/history.md);
+   the wrong pixels per outline pixel 1.40 -> 1.06, docs/history.md). The head is
+   bounded by the landmarks: above the middle of the neck (halfway from the ears'
+   midpoint to the shoulders'), what lies over ``head_radius`` from the ears' midpoint is
+   room for sure, and what lies over ``head_core_radius`` is room at first, person again
+   where GrabCut finds it of the person's colours (both radii in eyes-to-ankles lengths).
+   The learned mask takes in what stands behind the head with a probability of 0.6-0.9
+   (a picture on the wall read as hair, the silhouette 5-10 % too tall); on the room
+   benchmark's truth masks the head reaches 0.078-0.113 of that length from the ears;
 3. step 4's refinement, each pixel's backdrop colour the mean of the photo outside the
    region within ``surroundings_window_px`` (whatever lies behind that stretch of the
    outline: a wall, a floor, the shadow at the feet), except where the person's and the
@@ -138,6 +145,9 @@ class SilhouetteSettings:
         grabcut_inside_px, grabcut_outside_px: the learned region's pixels this far inside
             its outline are person for GrabCut, and those this far outside it room.
         grabcut_iterations: GrabCut's iterations.
+        head_radius, head_core_radius: above the neck's middle, the learned region's
+            pixels further than these from the ears' midpoint are room for sure, and room
+            until GrabCut finds them of the person's colours; eyes-to-ankles lengths.
     """
 
     border_band_fraction: float = 0.04
@@ -161,6 +171,8 @@ class SilhouetteSettings:
     grabcut_inside_px: int = 8
     grabcut_outside_px: int = 12
     grabcut_iterations: int = 4
+    head_radius: float = 0.13
+    head_core_radius: float = 0.08
 
     def __post_init__(self) -> None:
         if self.median_px < 1 or self.median_px % 2 == 0:
@@ -410,7 +422,7 @@ def _learned_silhouette(image_bgr: np.ndarray, settings: SilhouetteSettings) -> 
 
     found = person_segmenter()(image_bgr)
     region = _person_region(found.probability >= _LEARNED_THRESHOLD, settings)
-    region = _person_region(_graph_cut(image_bgr, region, settings), settings)
+    region = _person_region(_graph_cut(image_bgr, region, found.landmarks, settings), settings)
     backdrop, _ = _window_mean(image_bgr.astype(np.float32), ~region,
                                settings.surroundings_window_px)
     for _ in range(settings.outline_passes):
@@ -420,13 +432,34 @@ def _learned_silhouette(image_bgr: np.ndarray, settings: SilhouetteSettings) -> 
     return _fill_small_holes(region, settings)
 
 
-def _graph_cut(image: np.ndarray, learned: np.ndarray, settings: SilhouetteSettings
-               ) -> np.ndarray:
+def _head_zones(landmarks: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                settings: SilhouetteSettings) -> tuple[np.ndarray, np.ndarray]:
+    """(beyond, loose): (len(rows), len(cols)) bool over the pixels at ``rows`` x ``cols``
+    (1-D pixel indices), True above the neck's middle further than ``head_radius`` and
+    ``head_core_radius`` from the ears' midpoint. The neck's middle is halfway from the
+    ears' midpoint to the shoulders' along the body's axis (ankles to eyes), so the zones
+    hold in a photo of any orientation; ``landmarks`` (33, 5) are BlazePose's (x, y in
+    pixels; :class:`~bodyfit.calib.segment.PersonFound`)."""
+    ears, eyes = landmarks[[7, 8], :2].mean(0), landmarks[[2, 5], :2].mean(0)
+    shoulders, ankles = landmarks[[11, 12], :2].mean(0), landmarks[[27, 28], :2].mean(0)
+    length = float(np.linalg.norm(eyes - ankles))
+    up = (eyes - ankles) / max(length, 1e-6)
+    dx, dy = (cols[None, :] - ears[0]).astype(np.float32), (rows[:, None] - ears[1]).astype(np.float32)
+    above = dx * up[0] + dy * up[1] > 0.5 * float((shoulders - ears) @ up)
+    squared = dx * dx + dy * dy
+    return (above & (squared > (settings.head_radius * length) ** 2),
+            above & (squared > (settings.head_core_radius * length) ** 2))
+
+
+def _graph_cut(image: np.ndarray, learned: np.ndarray, landmarks: np.ndarray,
+               settings: SilhouetteSettings) -> np.ndarray:
     """(H, W) bool: OpenCV's GrabCut (colour models of the person and the room, the cut
     drawn along the photo's edges) started from the ``learned`` region: person for sure
     ``grabcut_inside_px`` inside its outline, room for sure ``grabcut_outside_px`` outside
-    it, either in between; over the box about that band only. The same photo gives the
-    same cut whatever ran before (OpenCV's generator is seeded)."""
+    it, either in between; over the box about that band only. About the head the
+    ``landmarks``' zones (:func:`_head_zones`) are room: the further one for sure, the
+    nearer one at first. The same photo gives the same cut whatever ran before (OpenCV's
+    generator is seeded)."""
     def disc(radius: int) -> np.ndarray:
         return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1,) * 2)
     marked = learned.astype(np.uint8)
@@ -438,6 +471,10 @@ def _graph_cut(image: np.ndarray, learned: np.ndarray, settings: SilhouetteSetti
     rows, cols = np.nonzero(near)
     box = (slice(max(rows.min() - 1, 0), rows.max() + 2), slice(max(cols.min() - 1, 0), cols.max() + 2))
     boxed = np.ascontiguousarray(labels[box])
+    beyond, loose = _head_zones(landmarks, np.arange(learned.shape[0])[box[0]],
+                                np.arange(learned.shape[1])[box[1]], settings)
+    boxed[loose & learned[box]] = cv2.GC_PR_BGD
+    boxed[beyond] = cv2.GC_BGD
     cv2.setRNGSeed(0)  # GrabCut's k-means starts from OpenCV's global generator
     cv2.grabCut(np.ascontiguousarray(image[box]), boxed, None, np.zeros((1, 65)),
                 np.zeros((1, 65)), settings.grabcut_iterations, cv2.GC_INIT_WITH_MASK)

@@ -251,3 +251,35 @@ def test_load_mask_reads_user_masks(tmp_path, studio):
 def test_settings_are_checked():
     with pytest.raises(ValueError, match="odd"):
         SilhouetteSettings(median_px=4)
+
+
+def _landmarks_upright() -> np.ndarray:
+    """(33, 5) BlazePose-ordered landmarks of a person standing upright: eyes and ears at
+    (500, 300), shoulders at (500, 400), ankles at (500, 1300): the eyes-to-ankles length
+    is 1000 px and the neck's middle 50 px below the ears."""
+    landmarks = np.zeros((33, 5), np.float32)
+    landmarks[[2, 5, 7, 8], :2] = (500, 300)
+    landmarks[[11, 12], :2] = (500, 400)
+    landmarks[[27, 28], :2] = (500, 1300)
+    return landmarks
+
+
+@pytest.mark.parametrize("quarter_turns", [0, 1])
+def test_the_head_zones_lie_about_the_ears_above_the_neck(quarter_turns):
+    """Radii 0.13 and 0.08 of the 1000-px eyes-to-ankles length about the ears, above the
+    neck's middle; a photo on its side (landmarks turned with it) gives the zones turned."""
+    from bodyfit.calib.silhouette import _head_zones
+
+    settings = SilhouetteSettings()
+    landmarks = _landmarks_upright()
+    points = {(500, 300 - 131): (True, True), (500, 300 - 129): (False, True),
+              (500 + 79, 300): (False, False), (500 - 85, 300): (False, True),
+              (500 + 140, 300 + 45): (True, True), (500 + 140, 300 + 55): (False, False)}
+    if quarter_turns:  # turned 90 degrees clockwise in a 2000 x 2000 photo: (x, y) -> (1999 - y, x)
+        landmarks[:, :2] = np.column_stack([1999 - landmarks[:, 1], landmarks[:, 0]])
+        points = {(1999 - y, x): zones for (x, y), zones in points.items()}
+    rows, cols = np.arange(2000), np.arange(2000)
+    beyond, loose = _head_zones(landmarks, rows, cols, settings)
+    for (x, y), zones in points.items():
+        assert (beyond[y, x], loose[y, x]) == zones, (x, y)
+    assert not (beyond & ~loose).any()
