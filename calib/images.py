@@ -124,18 +124,21 @@ def _exif_fields(exif: bytes, size_px: tuple[int, int]) -> tuple[int, float | No
 def native_messages_logged(source: str | Path):
     """Within it, what native libraries write to the process's standard error goes to the
     debug log instead, each line under ``source``: libjpeg's "Premature end of JPEG file"
-    beside the one line a corrupt photo gets, LiteRT's note on its CPU delegate."""
+    beside the one line a corrupt photo gets, LiteRT's note on its CPU delegate. It yields
+    a list that holds those lines once the block has ended."""
     sys.stderr.flush()
     saved = os.dup(2)
+    said: list[str] = []
     with tempfile.TemporaryFile() as sink:
         os.dup2(sink.fileno(), 2)
         try:
-            yield
+            yield said
         finally:
             os.dup2(saved, 2)
             os.close(saved)
             sink.seek(0)
-            for line in sink.read().decode(errors="replace").splitlines():
+            said.extend(sink.read().decode(errors="replace").splitlines())
+            for line in said:
                 log.debug("%s: a native library said: %s", source, line)
 
 
@@ -143,17 +146,22 @@ def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, lis
     """``cv2.imreadWithMetadata(path, flags)``: (pixels, metadata kinds, metadata blocks).
 
     Raises UserError when the file is missing or OpenCV cannot decode it (corrupt,
-    truncated, not an image, or declaring more pixels than OpenCV accepts).
+    not an image, or declaring more pixels than OpenCV accepts), or when it is a JPEG cut
+    short (libjpeg fills the missing rows in grey and says "Premature end of JPEG file").
     """
     path = Path(path)
     check_input_file(path)
+    said: list[str] = []
     try:
-        with native_messages_logged(path):
+        with native_messages_logged(path) as said:
             pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), flags)
     except cv2.error:  # e.g. a header claiming a width above CV_IO_MAX_IMAGE_WIDTH
         pixels, kinds, blocks = None, [], []
     if pixels is None or pixels.size == 0:
         raise UserError(f"{path}: not a readable image (OpenCV cannot decode it)")
+    if any("Premature end of JPEG file" in line for line in said):
+        raise UserError(f"{path}: the file is cut short (its JPEG data ends early); copy "
+                        "the photo from the phone again")
     return pixels, kinds, blocks
 
 
