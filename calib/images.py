@@ -151,7 +151,6 @@ def read_image_file(path: str | Path, flags: int) -> tuple[np.ndarray, list, lis
     """
     path = Path(path)
     check_input_file(path)
-    said: list[str] = []
     try:
         with native_messages_logged(path) as said:
             pixels, kinds, blocks = cv2.imreadWithMetadata(str(path), flags)
