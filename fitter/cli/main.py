@@ -24,6 +24,15 @@ __all__ = ["main"]
 logger = logging.getLogger("bodyfit")
 
 
+def _add_silhouette_options(parser: argparse.ArgumentParser) -> None:
+    """How the photos' silhouettes are taken: background plates and the segmenter."""
+    parser.add_argument("--background-front", metavar="PHOTO",
+                        help="background plate: the front view without the person")
+    parser.add_argument("--background-side", metavar="PHOTO",
+                        help="background plate, side view")
+    parser.add_argument("--segmenter", choices=SEGMENTERS, help=SEGMENTER_HELP)
+
+
 def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
     """`fitter run`'s options; `fitter batch` takes the same fit options for every subject
     (its table gives each subject's photos, stature, masks and optionally camera, sex and
@@ -70,11 +79,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
         parser.add_argument("--mask-front", metavar="PNG", help="your own front silhouette "
                             "(white person on black, of the undistorted upright photo)")
         parser.add_argument("--mask-side", metavar="PNG", help="your own side silhouette")
-    parser.add_argument("--background-front", metavar="PHOTO",
-                        help="background plate: the front view without the person")
-    parser.add_argument("--background-side", metavar="PHOTO",
-                        help="background plate, side view")
-    parser.add_argument("--segmenter", choices=SEGMENTERS, help=SEGMENTER_HELP)
+    _add_silhouette_options(parser)
     parser.add_argument("--no-check", dest="check", action="store_const", const=False,
                         help="skip the photography check (fitter check) before the fit")
     parser.add_argument("--sex", choices=("female", "male", "unknown"),
@@ -240,11 +245,8 @@ def _build_parser() -> argparse.ArgumentParser:
     check.add_argument("side", metavar="SIDE", help="side photo, arms hanging down")
     check.add_argument("--camera", metavar="camera.json",
                        help="the calibrated camera: the photos are undistorted first")
-    check.add_argument("--segmenter", choices=SEGMENTERS, default="auto", help=SEGMENTER_HELP)
-    check.add_argument("--background-front", metavar="PHOTO",
-                       help="background plate: the front view without the person")
-    check.add_argument("--background-side", metavar="PHOTO",
-                       help="background plate, side view")
+    _add_silhouette_options(check)
+    check.set_defaults(segmenter="auto")
 
     run = sub.add_parser(
         "run", help="fit the body model to a person's front and side photos: mesh (m), "
