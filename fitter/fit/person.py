@@ -124,22 +124,30 @@ def _upright_photos(inputs: PersonInputs, camera) -> dict[str, np.ndarray]:
     return {view: upright_photo(getattr(inputs, view), camera) for view in ("front", "side")}
 
 
-def checked_photos(inputs: PersonInputs, masks: dict[str, np.ndarray] | None = None,
-                   photos: dict[str, np.ndarray] | None = None) -> list[ViewVerdict]:
-    """The photography check of the person's photos, front then side
-    (:func:`bodyfit.fitter.check.photos.check_view`), on ``masks`` (default: their
-    silhouettes, without :func:`person_masks`' own refusals) and ``photos`` (default:
-    :func:`upright_photo` of each). Of ``inputs`` it reads the photos, masks, background
-    plates, camera and segmenter only.
+def _camera(inputs: PersonInputs):
+    """The calibrated camera of ``inputs``, or None."""
+    return load_camera(inputs.camera) if inputs.camera else None
+
+
+def _verdicts(masks: dict[str, np.ndarray], photos: dict[str, np.ndarray]
+              ) -> list[ViewVerdict]:
+    """The photography check of each view, front then side
+    (:func:`bodyfit.fitter.check.photos.check_view`)."""
+    return [check_view(view, photos[view], masks[view]) for view in ("front", "side")]
+
+
+def checked_photos(inputs: PersonInputs) -> list[ViewVerdict]:
+    """The photography check of the person's photos, front then side, on their
+    silhouettes (without :func:`person_masks`' own refusals) and :func:`upright_photo` of
+    each. Of ``inputs`` it reads the photos, masks, background plates, camera and
+    segmenter only.
 
     Raises:
         UserError: unreadable files, no person, several people, a person cut by the frame.
     """
     inputs.validate_photos()
-    camera = load_camera(inputs.camera) if inputs.camera else None
-    masks = masks or _masks(inputs, camera)
-    photos = photos or _upright_photos(inputs, camera)
-    return [check_view(view, photos[view], masks[view]) for view in ("front", "side")]
+    camera = _camera(inputs)
+    return _verdicts(_masks(inputs, camera), _upright_photos(inputs, camera))
 
 
 def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
@@ -152,8 +160,12 @@ def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
             photos, or a front photo with the arms against the body.
     """
     inputs.validate()
-    camera = load_camera(inputs.camera) if inputs.camera else None
-    masks = _masks(inputs, camera)
+    return _framed(_masks(inputs, _camera(inputs)))
+
+
+def _framed(masks: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """``masks``, or UserError where they show a person cut by the frame, front and side
+    swapped, two front photos, or a front photo with the arms against the body."""
     aspect = {}
     for view, mask in masks.items():
         rows, cols = np.nonzero(mask)
@@ -249,11 +261,13 @@ def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
         PhotoCheckFailed: the check's problems, one line each (after the masks' own
             refusals, each a single line that names the problem of the pair).
     """
-    masks = person_masks(inputs)
-    images = _upright_photos(inputs, load_camera(inputs.camera) if inputs.camera else None)
+    inputs.validate()
+    camera = _camera(inputs)
+    masks = _framed(_masks(inputs, camera))
+    images = _upright_photos(inputs, camera)
     warnings = None
     if inputs.check:
-        verdicts = checked_photos(inputs, masks, images)
+        verdicts = _verdicts(masks, images)
         problems = failed_lines(verdicts)
         if problems:
             raise PhotoCheckFailed("\n".join(problems))
