@@ -84,9 +84,10 @@ def one_line(text: str) -> str:
 
 def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object],
                 out_dir: Path) -> SubjectJob:
-    """The job of one row: the row's inputs (its camera and sex, else the batch's
-    ``options["camera"]`` and ``options["sex"]``; the batch's background plates,
-    segmenter and photography check) and
+    """The job of one row: the row's inputs (its camera, background plates and sex, else
+    the batch's ``options["camera"]``, ``options["background_front"]`` and
+    ``["background_side"]``, and ``options["sex"]``; the batch's segmenter and photography
+    check) and
     ``base`` with the batch's fit options (:func:`~bodyfit.fitter.run.options.fit_settings`),
     the row's weights replacing ``--weights`` (``--weight`` overrides still apply).
 
@@ -104,8 +105,8 @@ def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object
     given = row.inputs
     inputs = dataclasses.replace(
         given, camera=given.camera or options.get("camera"),
-        background_front=options.get("background_front"),
-        background_side=options.get("background_side"),
+        background_front=given.background_front or options.get("background_front"),
+        background_side=given.background_side or options.get("background_side"),
         segmenter=options.get("segmenter") or "auto",
         check=options.get("check") is not False,
         sex=given.sex if given.sex != "unknown" else options.get("sex") or "unknown")

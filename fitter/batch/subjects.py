@@ -11,6 +11,8 @@ A UTF-8 CSV file with a header row. Columns (any order, names as written here):
   down), as ``fitter run --front/--side``;
 - ``height_cm`` (required): stature, centimetres;
 - ``camera``, ``mask_front``, ``mask_side`` (optional): as the ``fitter run`` options;
+- ``background_front``, ``background_side`` (optional): the subject's background plates,
+  as ``fitter run --background-front/--background-side`` (else the batch's, if any);
 - ``sex`` (optional): female, male or unknown (empty or unknown: the batch's ``--sex``);
 - ``weights`` (optional): a weights preset or a .toml file, as ``--weights``.
 
@@ -41,8 +43,10 @@ __all__ = ["REQUIRED_COLUMNS", "OPTIONAL_COLUMNS", "RESERVED_IDS", "SubjectRow",
            "SubjectTable", "read_subjects", "id_problem"]
 
 REQUIRED_COLUMNS = ("id", "front", "side", "height_cm")
-OPTIONAL_COLUMNS = ("camera", "mask_front", "mask_side", "sex", "weights")
-_PATH_COLUMNS = ("front", "side", "camera", "mask_front", "mask_side")
+OPTIONAL_COLUMNS = ("camera", "mask_front", "mask_side", "background_front", "background_side",
+                    "sex", "weights")
+_PATH_COLUMNS = ("front", "side", "camera", "mask_front", "mask_side", "background_front",
+                 "background_side")
 #: Names of the batch's own files in OUT, which no subject folder may take.
 RESERVED_IDS = ("summary.csv", "failures.csv", "batch.json")
 _ID_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
@@ -54,9 +58,9 @@ class SubjectRow:
 
     Attributes:
         subject_id: the id (its output folder's name).
-        inputs: the row's photos, stature, camera, masks and sex as `fitter run` takes
-            them; a camera or sex the row leaves empty is None or ``"unknown"``, and the
-            batch's ``--camera``/``--sex`` apply (:func:`~bodyfit.fitter.batch.job.subject_job`).
+        inputs: the row's photos, stature, camera, masks, background plates and sex as
+            `fitter run` takes them; a camera, plate or sex the row leaves empty is None or
+            ``"unknown"``, and the batch's ``--camera``/``--background-*``/``--sex`` apply (:func:`~bodyfit.fitter.batch.job.subject_job`).
         weights: a preset name, a .toml path, or None.
         line: the row's line number in the file (1 is the header).
     """

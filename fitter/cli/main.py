@@ -263,7 +263,8 @@ def _build_parser() -> argparse.ArgumentParser:
         "batch", help="fit every subject of a table (SUBJECTS.csv) as fitter run does, on "
                       "local worker processes or a Ray cluster; resumable",
         description="Fit every row of SUBJECTS.csv (columns id, front, side, height_cm; "
-                    "optional camera, mask_front, mask_side, sex, weights; relative paths "
+                    "optional camera, mask_front, mask_side, background_front, "
+                    "background_side, sex, weights; relative paths "
                     "are relative to the CSV's folder) as fitter run does, into OUT/<id>/, "
                     "with OUT/summary.csv, OUT/failures.csv and OUT/batch.json. Subjects "
                     "already fitted in OUT are kept; a subject that fails is recorded and "

@@ -17,10 +17,11 @@ import cv2
 import numpy as np
 import pytest
 
-from bodyfit.fitter.batch.job import WORKER_EXIT_HOOK
+from bodyfit.fitter.batch.job import WORKER_EXIT_HOOK, subject_job
 from bodyfit.fitter.batch.subjects import read_subjects
 from bodyfit.fitter.cli.main import main
 from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.fit.person_fit import FitSettings
 from bodyfit.fitter.model.cache import CACHE_ENV_VAR
 from bodyfit.fitter.run.results import RUN_FILES
 from bodyfit.kernels import cpu_threads
@@ -390,3 +391,20 @@ def test_table_paths_are_relative_to_its_folder(tmp_path, monkeypatch):
         str(photos / "f.png"), str(photos / "cam.json"), str(photos / "w.toml"), "female", 2)
     assert (b.inputs.front, b.inputs.camera, b.weights, b.inputs.sex, b.inputs.height_cm) == (
         str(photos / "f.png"), None, "paper", "unknown", 165.5)
+
+
+def test_a_rows_background_plates_replace_the_batchs(tmp_path):
+    for name in ("f.png", "s.png", "plate_f.png", "plate_s.png"):
+        (tmp_path / name).write_bytes(b"x")
+    table = write_table(tmp_path / "t.csv", [
+        ["a", "f.png", "s.png", "170", "plate_f.png", ""],
+        ["b", "f.png", "s.png", "170", "", ""]],
+        ("id", "front", "side", "height_cm", "background_front", "background_side"))
+    read = read_subjects(table)
+    assert not read.bad_rows
+    batch_plates = {"background_front": "/studio/front.png", "background_side": "/studio/side.png"}
+    a, b = (subject_job(row, FitSettings(), batch_plates, tmp_path / "out").inputs
+            for row in read.rows)
+    assert (a.background_front, a.background_side) == (str(tmp_path / "plate_f.png"),
+                                                       "/studio/side.png")
+    assert (b.background_front, b.background_side) == ("/studio/front.png", "/studio/side.png")
