@@ -30,6 +30,9 @@ Run from the repository root (docs/accuracy.md holds what they measured)::
     python -m bench.accuracy make SETS/room-out --kind out-of-space --count 200 --seed 0 \
         --rooms --first 24
     python -m bench.accuracy silhouettes SETS/room-out --first 24
+    # the same with each photo's background plate (the empty room from a tripod)
+    python -m bench.accuracy fit SETS/room-out plates --first 24 --plates
+    python -m bench.accuracy silhouettes SETS/room-out --first 24 --plates --segmenter backdrop
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python -m bench.accuracy figures SETS/in --curve "bodyfit=bodyfit" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -131,11 +134,11 @@ def _command(name: str) -> str:
 
 
 
-def _table_rows(folder: Path, first: int, keepends: bool = False, skip: int = 0) -> list[str]:
-    """subjects.csv's header and its first ``first`` rows but the first ``skip``: as many
-    women as men when both are even (subject_set's order)."""
-    lines = (folder / "subjects.csv").read_text().splitlines(keepends)
-    return lines[:1] + lines[1 + skip:first + 1]
+def _table_rows(folder: Path, first: int | None, skip: int = 0) -> list[str]:
+    """subjects.csv's header and its rows ``skip`` to ``first`` - 1 (to the last without
+    ``first``): as many women as men when both are even (subject_set's order)."""
+    lines = (folder / "subjects.csv").read_text().splitlines()
+    return lines[:1] + lines[1 + skip:None if first is None else first + 1]
 
 
 
@@ -169,10 +172,17 @@ def fit(args, batch_options: list[str]) -> None:
                        stdout=subprocess.DEVNULL)
     out = folder / "runs" / args.name
     table = folder / "subjects.csv"
-    if args.first:
-        table = folder / (f"subjects-rows{args.skip}-{args.first - 1}.csv" if args.skip
-                          else f"subjects-first{args.first}.csv")
-        table.write_text("".join(_table_rows(folder, args.first, True, args.skip)))
+    if args.first or args.plates:
+        rows = _table_rows(folder, args.first, args.skip)
+        if args.plates:
+            ids = [row.split(",", 1)[0] for row in rows]
+            rows = [rows[0] + ",background_front,background_side"] + [
+                f"{row},{subject}/plate_front.jpg,{subject}/plate_side.jpg"
+                for row, subject in zip(rows[1:], ids[1:])]
+        window = (f"-rows{args.skip}-{args.first - 1}" if args.skip
+                  else f"-first{args.first}") if args.first else ""
+        table = folder / f"subjects{window}{'-plates' if args.plates else ''}.csv"
+        table.write_text("".join(row + "\n" for row in rows))
     # a set with uncalibrated subjects names each subject's camera in its table
     per_row = read_settings(folder).per_row_camera
     command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
@@ -394,8 +404,10 @@ def silhouettes(args) -> None:
             for subject in subjects:
                 truth = cv2.imread(str(folder / subject / f"truth_{view}.png"),
                                    cv2.IMREAD_GRAYSCALE) > 127
+                plate = folder / subject / f"plate_{view}.jpg" if args.plates else None
                 try:
-                    mask = photo_silhouette(folder / subject / f"{view}.jpg", segmenter=segmenter)
+                    mask = photo_silhouette(folder / subject / f"{view}.jpg",
+                                            background_path=plate, segmenter=segmenter)
                 except UserError:
                     refused += 1
                     continue
@@ -439,6 +451,9 @@ def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
                    help="with --first N: leave out the first I subjects (fitted by another "
                    "run, e.g. in an earlier session), fit rows I to N - 1; the run's summary.csv "
                    "keeps the rows it had of other subjects")
+    p.add_argument("--plates", action="store_true",
+                   help="a room set's photos with their background plates (plate_front.jpg, "
+                   "plate_side.jpg: the empty room from a tripod)")
     p = sub.add_parser("keep", help="merge a run into a setting kept in git")
     p.add_argument("set")
     p.add_argument("name", help="the run's name (SET/runs/NAME)")
@@ -472,6 +487,9 @@ def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
     p.add_argument("set", help="a set made with make --rooms")
     p.add_argument("--first", type=int, help="its first N subjects only")
     p.add_argument("--segmenter", nargs="+", choices=SEGMENTERS, default=list(SEGMENTERS))
+    p.add_argument("--plates", action="store_true",
+                   help="each photo against its background plate (the learned segmentation "
+                   "takes none)")
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",

@@ -9,6 +9,9 @@ changes:
   centre-cropped to the photo's aspect, scaled to its size, mirrored or not;
 - **a contact shadow**: the room darkened under the feet, by up to
   ``SHADOW_DEPTH`` at the centre of a soft ellipse about the lowest rows of the body;
+- **a background plate** per photo: the same room from the same place without the
+  person (nor their shadow), as a user photographs it from a tripod for
+  ``--background-front/--background-side``;
 - **clothes**: each part painted as a person dresses it (:func:`dressed_colours`: skin,
   hair on the head's top and back, a top with long or short sleeves, trousers, shoes),
   shaded as :func:`bodyfit.fitter.output.render.render_pinhole` shades (by how squarely
@@ -35,12 +38,15 @@ from bodyfit.calib.synthetic import distort_image
 from bodyfit.fitter.demo.studio_photos import pinhole_layers
 from bodyfit.fitter.model.body_model import PART_NAMES, BodyModel
 
-__all__ = ["ROOMS_FOLDER", "SHADOW_DEPTH", "RoomScene", "draw_scene", "dressed_colours",
-           "room_photo"]
+__all__ = ["PLATE_EXPOSURE", "ROOMS_FOLDER", "SHADOW_DEPTH", "RoomScene", "draw_scene",
+           "dressed_colours", "room_photo"]
 
 ROOMS_FOLDER = Path(__file__).parents[1] / "data" / "rooms"
 #: The contact shadow darkens the floor by this share at its centre.
 SHADOW_DEPTH = 0.45
+#: A background plate's exposure differs from its photo's by up to this share (a phone
+#: meters the empty room a little differently).
+PLATE_EXPOSURE = 0.03
 # BGR palettes the clothes and the skin are drawn from
 _SKIN = ((180, 200, 235), (140, 170, 215), (110, 145, 190), (70, 100, 145), (45, 65, 100))
 _HAIR = ((25, 25, 30), (30, 45, 70), (45, 75, 115), (120, 170, 205), (150, 150, 155))
@@ -58,12 +64,14 @@ class RoomScene:
         room: the room photo's file name in ``ROOMS_FOLDER``; mirrored: flipped left-right.
         part_colours: (10, 3) uint8 BGR, ``PART_NAMES`` order.
         hair: (3,) uint8 BGR.
+        plate_seed: the seed of the background plates' noise and exposure.
     """
 
     room: str
     mirrored: bool
     part_colours: np.ndarray
     hair: np.ndarray
+    plate_seed: int
 
 
 def draw_scene(rng: np.random.Generator) -> RoomScene:
@@ -79,7 +87,8 @@ def draw_scene(rng: np.random.Generator) -> RoomScene:
     colours |= {part: top for part in _TOP_PARTS}
     part_colours = np.array([colours[name] for name in PART_NAMES], np.uint8)
     return RoomScene(rooms[rng.integers(len(rooms))], bool(rng.random() < 0.5), part_colours,
-                     np.array(_HAIR[rng.integers(len(_HAIR))], np.uint8))
+                     np.array(_HAIR[rng.integers(len(_HAIR))], np.uint8),
+                     int(rng.integers(2**31)))
 
 
 def dressed_colours(model: BodyModel, vertices: np.ndarray, scene: RoomScene) -> np.ndarray:
@@ -128,22 +137,26 @@ def _shadowed(room: np.ndarray, body: np.ndarray) -> np.ndarray:
 
 def room_photo(vertices: np.ndarray, model: BodyModel, view: str, camera: Camera,
                distance_m: float, camera_height_m: float, pitch_deg: float,
-               scene: RoomScene) -> tuple[np.ndarray, np.ndarray]:
-    """(photo (H, W, 3) uint8 BGR, truth (H, W) bool) of the posed body ``vertices``
-    (V, 3) metres, dressed, in ``scene``'s room, through ``camera`` from its place, as
-    :func:`bodyfit.fitter.demo.studio_photos.lens_photo` photographs it on the plain
-    backdrop; truth: the pixels it covers by more than half, through the same lens."""
+               scene: RoomScene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(photo (H, W, 3) uint8 BGR, truth (H, W) bool, plate (H, W, 3) uint8 BGR) of the
+    posed body ``vertices`` (V, 3) metres, dressed, in ``scene``'s room, through
+    ``camera`` from its place, as :func:`bodyfit.fitter.demo.studio_photos.lens_photo`
+    photographs it on the plain backdrop; truth: the pixels it covers by more than half,
+    through the same lens; plate: the room alone, through the same lens."""
     size = tuple(camera.image_size_px)
     image, body = pinhole_layers(np.asarray(vertices, np.float64), model, view, PART_NAMES,
                                  camera.K, size, distance_m, camera_height_m, (pitch_deg, 0.0),
                                  dressed_colours(model, vertices, scene))
     room = _room(scene.room, size)
-    canvas = _shadowed(room[:, ::-1] if scene.mirrored else room, body)
+    plate = np.ascontiguousarray(room[:, ::-1]) if scene.mirrored else room.copy()
+    canvas = _shadowed(plate, body)
     canvas[body] = image[body]
     truth = body.astype(np.uint8) * 255
     if np.any(camera.dist):
-        canvas = distort_image(canvas, camera.K, camera.dist,
-                               tuple(float(v) for v in canvas.reshape(-1, 3).mean(axis=0)))
+        # beyond the pinhole picture's edge the lens sees the photo's mean colour
+        fill = tuple(float(v) for v in canvas.reshape(-1, 3).mean(axis=0))
+        canvas, plate = (distort_image(picture, camera.K, camera.dist, fill)
+                         for picture in (canvas, plate))
         truth = distort_image(truth, camera.K, camera.dist)
-    return canvas, truth > 127
+    return canvas, truth > 127, plate
 

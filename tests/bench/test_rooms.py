@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from bench.accuracy.outlines import height_error, outline_errors
-from bench.accuracy.rooms import (SHADOW_DEPTH, RoomScene, _room, draw_scene, dressed_colours,
-                                  room_photo)
+from bench.accuracy.rooms import (PLATE_EXPOSURE, SHADOW_DEPTH, RoomScene, _room, draw_scene,
+                                  dressed_colours, room_photo)
 from bench.accuracy.subject_set import SetSettings, write_bodies, write_photos_of_set
 from bodyfit.calib.camera import Camera
 from bodyfit.calib.silhouette import extract_silhouette
@@ -63,13 +63,15 @@ def test_a_scene_is_drawn_from_its_stream_and_dresses_by_part(body_model):
 
 def test_room_photo_puts_the_body_on_the_room_with_a_shadow_at_its_feet(body_model):
     """Through a lens without distortion: the truth is the body's coverage, the photo is
-    the room outside it, darker just under the feet by up to SHADOW_DEPTH."""
+    the room outside it, darker just under the feet by up to SHADOW_DEPTH, and the plate
+    is the room alone."""
     camera = demo_camera((600, 800))
     camera = Camera(camera.image_size_px, camera.K, np.zeros(5))
     scene = RoomScene("white-room.jpg", False, draw_scene(np.random.default_rng(1)).part_colours,
-                      np.array([30, 30, 30], np.uint8))
+                      np.array([30, 30, 30], np.uint8), 0)
     vertices = body_model.mean_vertices.astype(np.float64)
-    photo, truth = room_photo(vertices, body_model, "front", camera, 3.0, 1.1, 0.0, scene)
+    photo, truth, plate = room_photo(vertices, body_model, "front", camera, 3.0, 1.1, 0.0,
+                                     scene)
     _, covered = pinhole_layers(vertices, body_model, "front", PART_NAMES, camera.K, (600, 800),
                                 3.0, 1.1)
     assert np.array_equal(truth, covered)
@@ -81,12 +83,16 @@ def test_room_photo_puts_the_body_on_the_room_with_a_shadow_at_its_feet(body_mod
     far = ~cv2.dilate(truth.astype(np.uint8), np.ones((61, 61), np.uint8)).astype(bool)
     far[rows.max() - 150:, :] = False  # the shadow's reach
     assert np.abs(photo[far].astype(float) - room[far]).max() <= 1
+    assert np.array_equal(plate, room.astype(np.uint8))
 
 
 def test_a_room_set_photographs_the_plain_sets_bodies_from_the_same_places(body_model, tmp_path):
     """Its subject's truth.json (measurements, camera place) is the plain set's, and its
     truth mask is the plain photo's silhouette (the backdrop's colour model's, within the
-    JPEG's and the lens's blur)."""
+    JPEG's and the lens's blur). Its plate is the photo's room: away from the body and its
+    shadow the two differ by the exposure (up to PLATE_EXPOSURE) and noise; against it
+    the backdrop's colour model finds the body (but the shadow between the feet and a
+    shoe of the floor's colour)."""
     truths, masks = {}, {}
     for rooms in (False, True):
         folder = tmp_path / ("room" if rooms else "plain")
@@ -102,4 +108,17 @@ def test_a_room_set_photographs_the_plain_sets_bodies_from_the_same_places(body_
     truth = cv2.imread(str(masks[True] / "truth_front.png"), cv2.IMREAD_GRAYSCALE) > 127
     backdrop = extract_silhouette(cv2.imread(str(masks[False] / "front.jpg")),
                                   segmenter="backdrop")
-    assert (backdrop & truth).sum() / (backdrop | truth).sum() > 0.98
+
+    def iou(mask: np.ndarray) -> float:
+        return (mask & truth).sum() / (mask | truth).sum()
+
+    assert iou(backdrop) > 0.98
+    photo, plate = (cv2.imread(str(masks[True] / name)) for name in ("front.jpg",
+                                                                      "plate_front.jpg"))
+    rows, _ = np.nonzero(truth)
+    far = ~cv2.dilate(truth.astype(np.uint8), np.ones((61, 61), np.uint8)).astype(bool)
+    far[rows.max() - 150:, :] = False  # the shadow's reach
+    exposure = np.median(photo[far].sum(axis=1) / np.maximum(plate[far].sum(axis=1), 1))
+    assert abs(exposure - 1) <= PLATE_EXPOSURE + 0.01
+    assert np.percentile(np.abs(photo[far] - exposure * plate[far].astype(float)), 99) < 15
+    assert iou(extract_silhouette(photo, plate, segmenter="backdrop")) > 0.92
