@@ -153,11 +153,13 @@ def test_the_shadow_is_really_there(studio):
 
 
 def test_background_plate_handles_a_busy_room():
+    """The backdrop's colour model against a plate (``auto`` takes the learned
+    segmentation with a room's plate, which finds no person in this drawn figure)."""
     rng = np.random.default_rng(1)
     room = clutter(SIZE, rng)
     photo, truth = studio_photo(SIZE, [PERSON], rng, backdrop=room, shadow=False)
     plate = np.clip(room + rng.normal(0.0, 4.0, room.shape), 0, 255).astype(np.uint8)
-    assert iou(extract_silhouette(photo, plate), truth) >= 0.99
+    assert iou(extract_silhouette(photo, plate, segmenter="backdrop"), truth) >= 0.99
     with pytest.raises(UserError, match="backdrop is not plain"):
         extract_silhouette(photo, segmenter="backdrop")
 
@@ -283,3 +285,28 @@ def test_the_head_zones_lie_about_the_ears_above_the_neck(quarter_turns):
     for (x, y), zones in points.items():
         assert (beyond[y, x], loose[y, x]) == zones, (x, y)
     assert not (beyond & ~loose).any()
+
+
+def test_a_plates_evidence_matches_its_exposure_and_tells_a_shadow_from_clothes():
+    """A photo 4 % brighter than its plate, with a shirt-coloured square, a shadow (0.6
+    of the plate), and a 3 x 3 patch of the plate the shirt's colour: the room is the
+    plate's colour (128 in the difference) and room for sure, the square is unlike it
+    but for that patch, too small to be room for sure, and the shadow is neither."""
+    from bodyfit.calib.silhouette import _plate_evidence
+
+    rng = np.random.default_rng(4)
+    plate = clutter((400, 300), rng)
+    photo = np.clip(plate * 1.04 + rng.normal(0.0, 1.0, plate.shape), 0, 255)
+    photo[100:160, 100:160] = (40, 160, 200)
+    photo[200:260, 50:150] *= 0.6
+    photo = photo.astype(np.uint8)
+    plate[128:131, 128:131] = np.rint(photo[128:131, 128:131] / 1.04)
+    learned = np.zeros(plate.shape[:2], bool)
+    learned[90:170, 90:170] = True
+    difference, unlike, room = _plate_evidence(photo, plate, learned, SilhouetteSettings())
+    assert np.abs(np.median(difference[:60].astype(float), axis=(0, 1)) - 128).max() <= 1
+    assert room[:60].mean() > 0.95 and room[265:].mean() > 0.95
+    assert not room[100:160, 100:160].any() and not unlike[:60].any()
+    assert unlike[105:155, 105:155].sum() == 50 * 50 - 9 and not unlike[128:131, 128:131].any()
+    shadow = (slice(205, 255), slice(55, 145))
+    assert not unlike[shadow].any() and not room[shadow].any()
