@@ -115,6 +115,10 @@ _EXPOSURE_MARGIN_PX = 40
 #: Patches of a plate's colour narrower than this disc are no room for sure (a dark
 #: trouser pixel can match a dark floor's).
 _ROOM_PATCH_RADIUS_PX = 3
+#: A plate whose colour less of the room away from the person has than this share is
+#: not the photo's room (another spot, the phone moved): a matching plate of the room
+#: benchmark holds 0.92-0.97 of it, one shifted by 6 px 0.62 (0.87 in a white room).
+_MIN_PLATE_MATCH = 0.5
 
 
 class _NotSurrounded(UserError):
@@ -499,7 +503,11 @@ def _plate_evidence(image: np.ndarray, plate: np.ndarray, learned: np.ndarray,
     highlight of it; room (H, W) bool, solid patches of the plate's colour). The plate is
     first scaled by the exposure's ratio, the median over the pixels
     ``_EXPOSURE_MARGIN_PX`` away from the region (a phone meters the empty room a little
-    differently)."""
+    differently).
+
+    Raises:
+        UserError: less than ``_MIN_PLATE_MATCH`` of those pixels have the plate's colour.
+    """
     pixels, room_colour = image.astype(np.float32), plate.astype(np.float32)
     away = ~cv2.dilate(learned.astype(np.uint8), _disc(_EXPOSURE_MARGIN_PX)).astype(bool)
     if away.any():
@@ -513,6 +521,12 @@ def _plate_evidence(image: np.ndarray, plate: np.ndarray, learned: np.ndarray,
     unlike = cv2.morphologyEx(unlike.astype(np.uint8), cv2.MORPH_OPEN, _disc(1)).astype(bool)
     room = cv2.morphologyEx((difference <= settings.plate_same_grey).astype(np.uint8),
                             cv2.MORPH_OPEN, _disc(_ROOM_PATCH_RADIUS_PX)).astype(bool)
+    matched = float(room[away].mean()) if away.any() else 1.0
+    if matched < _MIN_PLATE_MATCH:
+        raise UserError(
+            f"the background plate does not match the photo: only {matched:.0%} of the room "
+            "around the person has the plate's colour; take the plate from the same spot "
+            "without moving the phone (a tripod), or leave it out")
     return np.clip(pixels - room_colour + 128, 0, 255).astype(np.uint8), unlike, room
 
 

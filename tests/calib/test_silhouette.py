@@ -310,3 +310,17 @@ def test_a_plates_evidence_matches_its_exposure_and_tells_a_shadow_from_clothes(
     assert unlike[105:155, 105:155].sum() == 50 * 50 - 9 and not unlike[128:131, 128:131].any()
     shadow = (slice(205, 255), slice(55, 145))
     assert not unlike[shadow].any() and not room[shadow].any()
+
+
+def test_a_plate_of_another_spot_is_a_user_error():
+    """A busy room's plate against a photo of another busy room (or of the same room
+    from a spot 40 px aside)."""
+    from bodyfit.calib.silhouette import _plate_evidence
+
+    photo = clutter((400, 300), np.random.default_rng(5))
+    learned = np.zeros(photo.shape[:2], bool)
+    learned[90:170, 90:170] = True
+    _plate_evidence(photo, photo, learned, SilhouetteSettings())  # its own room: no error
+    for plate in (clutter((400, 300), np.random.default_rng(6)), np.roll(photo, 40, axis=1)):
+        with pytest.raises(UserError, match="background plate does not match the photo: only"):
+            _plate_evidence(photo, plate, learned, SilhouetteSettings())
