@@ -32,7 +32,7 @@ Run from the repository root (docs/accuracy.md holds what they measured)::
     python -m bench.accuracy silhouettes SETS/room-out --first 24
     # the same with each photo's background plate (the empty room from a tripod)
     python -m bench.accuracy fit SETS/room-out plates --first 24 --plates
-    python -m bench.accuracy silhouettes SETS/room-out --first 24 --plates --segmenter backdrop
+    python -m bench.accuracy silhouettes SETS/room-out --first 24 --plates --segmenter auto
     # error per generation (the paper's Fig. 12), bodies coloured by distance (Figs. 16-17)
     python -m bench.accuracy figures SETS/in --curve "bodyfit=bodyfit" \
         --curve "uniform weights=uniform-weights" --meshes bodyfit "uniform weights"
@@ -488,8 +488,8 @@ def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
     p.add_argument("--first", type=int, help="its first N subjects only")
     p.add_argument("--segmenter", nargs="+", choices=SEGMENTERS, default=list(SEGMENTERS))
     p.add_argument("--plates", action="store_true",
-                   help="each photo against its background plate (the learned segmentation "
-                   "takes none)")
+                   help="each photo with its background plate (plate_front.jpg, "
+                   "plate_side.jpg)")
     p = sub.add_parser("figures", help="error per generation; bodies coloured by distance")
     p.add_argument("set")
     p.add_argument("--curve", action="append", default=[], metavar="LABEL=RUN",
