@@ -334,6 +334,11 @@ def _window_mean(values: np.ndarray, selected: np.ndarray, window_px: int
     return total / (share[..., None] if values.ndim == 3 else share), weight
 
 
+def _disc(radius: int) -> np.ndarray:
+    """A disc of ``radius`` pixels as OpenCV's structuring element."""
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1,) * 2)
+
+
 def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
                     settings: SilhouetteSettings, min_contrast: float = 0.0,
                     max_backdrop_spread: float = np.inf) -> np.ndarray:
@@ -358,10 +363,10 @@ def _refine_outline(image: np.ndarray, region: np.ndarray, backdrop: np.ndarray,
     """
     pixels = image.astype(np.float32)
     marked = region.astype(np.uint8)
-    shrink = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * settings.outline_band_px + 1,) * 2)
+    shrink = _disc(settings.outline_band_px)
     inside = cv2.erode(marked, shrink).astype(bool)
     outside = cv2.erode(1 - marked, shrink).astype(bool)
-    step = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (3, 3))
+    step = _disc(1)
     second = cv2.erode(marked, step)
     near_inside = second.astype(bool) & ~cv2.erode(second, step).astype(bool)
     window = settings.outline_window_px
@@ -488,11 +493,6 @@ def _head_zones(landmarks: np.ndarray, rows: np.ndarray, cols: np.ndarray,
     squared = dx * dx + dy * dy
     return (above & (squared > (settings.head_radius * length) ** 2),
             above & (squared > (settings.head_core_radius * length) ** 2))
-
-
-def _disc(radius: int) -> np.ndarray:
-    """A disc of ``radius`` pixels as OpenCV's structuring element."""
-    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1,) * 2)
 
 
 def _plate_evidence(image: np.ndarray, plate: np.ndarray, learned: np.ndarray,
