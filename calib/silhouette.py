@@ -628,11 +628,16 @@ def _backdrop_silhouette(image_bgr: np.ndarray, background: np.ndarray | None,
     return _fill_small_holes(region, settings)
 
 
-def load_mask(path: str | Path) -> np.ndarray:
-    """A user-made silhouette mask: (H, W) bool, True where the PNG is brighter than mid-grey.
+def load_mask(path: str | Path, settings: SilhouetteSettings = SilhouetteSettings()
+              ) -> np.ndarray:
+    """A user-made silhouette mask: (H, W) bool, the largest 8-connected region of the
+    pixels brighter than mid-grey (a segmentation network's stray blobs dropped: a shoe
+    beside the feet, a speck of the room).
 
     The mask must be of the undistorted, upright photo (e.g. drawn over the output of
-    ``calib undistort``). Raises UserError when it cannot be read or is empty.
+    ``calib undistort``). Raises UserError when it cannot be read, is empty or all white,
+    or holds a second region of at least ``settings.max_second_region_ratio`` of the
+    largest's area (two people).
     """
     path = Path(path)
     pixels, _, _ = read_image_file(path, cv2.IMREAD_GRAYSCALE)
@@ -641,7 +646,14 @@ def load_mask(path: str | Path) -> np.ndarray:
         raise UserError(
             f"{path}: the mask is all {'white' if mask.all() else 'black'}; the person must be white on black"
         )
-    return mask
+    labels, stats = _components(mask)
+    areas = stats[:, cv2.CC_STAT_AREA]
+    largest = int(np.argmax(areas))
+    similar = int(np.sum(areas >= settings.max_second_region_ratio * areas[largest]))
+    if similar > 1:
+        raise UserError(f"{path}: the mask holds {similar} person-sized regions; give a mask "
+                        "of one person")
+    return labels == largest + 1
 
 
 def photo_silhouette(

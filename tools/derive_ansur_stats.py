@@ -19,11 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
-#: bodyfit measurement key (paper Fig. 10) -> ANSUR II columns summed, all millimetres.
-#: C (shoulder-crotch length) has no ANSUR II column.
+#: bodyfit measurement key (paper Fig. 10), and ``mass_kg`` -> ANSUR II columns summed (a
+#: leading "-" subtracts one), all millimetres; C (shoulder-crotch length) is the acromion's
+#: height less the crotch's, bodyfit's definition.
 COLUMNS = {
     "A": ["headcircumference"],
     "B": ["neckcircumference"],
+    "C": ["acromialheight", "-crotchheight"],
     "D": ["chestcircumference"],
     "E": ["waistcircumference"],
     "F": ["buttockcircumference"],
@@ -37,15 +39,23 @@ COLUMNS = {
     "N": ["anklecircumference"],
     "O": ["stature"],
     "P": ["biacromialbreadth"],
+    "mass_kg": ["weightkg"],
 }
+#: ANSUR II's units per column where they are not millimetres: weightkg is in tenths of a
+#: kilogram.
+SCALES = {"weightkg": 0.1}
 FILES = {"male": "ANSUR_II_MALE_Public.csv", "female": "ANSUR_II_FEMALE_Public.csv"}
 
 
 def read_sex(path: Path) -> np.ndarray:
-    """(n, len(COLUMNS)) float64 millimetres, one row per subject."""
+    """(n, len(COLUMNS)) float64 millimetres (the mass in kg), one row per subject."""
     with open(path, newline="", encoding="latin-1") as fh:
         rows = list(csv.DictReader(fh))
-    return np.array([[sum(float(r[c]) for c in cols) for cols in COLUMNS.values()]
+    def value(row: dict, column: str) -> float:
+        sign, name = (-1.0, column[1:]) if column.startswith("-") else (1.0, column)
+        return sign * SCALES.get(name, 1.0) * float(row[name])
+
+    return np.array([[sum(value(r, c) for c in cols) for cols in COLUMNS.values()]
                      for r in rows])
 
 
@@ -57,8 +67,9 @@ def main() -> None:
                         default=here / "fitter/data/ansur2_stats.json")
     args = parser.parse_args()
     table = {"source": "ANSUR II public data (2012), derived by tools/derive_ansur_stats.py",
-             "units": "mm", "keys": list(COLUMNS),
-             "columns": {k: "+".join(v) for k, v in COLUMNS.items()}, "sexes": {}}
+             "units": "mm (mass_kg: kg)", "keys": list(COLUMNS),
+             "columns": {k: v[0] + "".join(c if c.startswith("-") else "+" + c for c in v[1:])
+                         for k, v in COLUMNS.items()}, "sexes": {}}
     for sex, name in FILES.items():
         x = read_sex(args.ansur_dir / name)
         table["sexes"][sex] = {

@@ -5,7 +5,7 @@ Run from the repository root (docs/accuracy.md, "Real people", holds what they m
     # the choice part's first 100 subjects (their first photo pair), the default method;
     # fitter batch options after -- (resumable: rerun to continue, or to fit more rows)
     python -m bench.bodym fit bodyfit --first 100
-    python -m bench.bodym fit mass --first 100 -- --mass-from-table
+    python -m bench.bodym fit mass --first 100 --mass
     # every photo pair of those subjects (repeat photos: the precision)
     python -m bench.bodym fit bodyfit-all --first 100 --photos all
     # the tables: per measurement, baselines beside, paired against another run
@@ -17,7 +17,8 @@ Run from the repository root (docs/accuracy.md, "Real people", holds what they m
 
 Each photo pair is fitted as the issue measured it: ``fitter batch --projection
 orthographic --no-check``, the masks padded with 48 px of black (the crops touch their
-frame), the stated height as the stature (``--height scan``: the scan's) and the sex.
+frame), the stated height as the stature (``--height scan``: the scan's), the sex and, with
+``--mass``, the stated weight.
 Runs, masks and tables lie in ``out/bodym/`` (git ignores it): per-person fits and errors
 never enter the repository (BodyM is CC BY-NC; evaluation only), only the aggregate
 tables that ``report`` prints.
@@ -75,13 +76,14 @@ def fit(args, batch_options: list[str]) -> None:
     subjects = _window(args)
     masks = RUNS / "masks"
     masks.mkdir(parents=True, exist_ok=True)
-    header = ["id", "front", "side", "mask_front", "mask_side", "height_cm", "sex"]
+    header = ["id", "front", "side", "mask_front", "mask_side", "height_cm", "sex", "mass_kg"]
     rows = []
     for s in subjects:
         height = s.stated_height_cm if args.height == "stated" else s.scan_height_cm
         for photo_id in (s.photo_ids if args.photos == "all" else s.photo_ids[:1]):
             front, side = (str(p.resolve()) for p in _padded_masks(photo_id, split, masks))
-            rows.append([photo_id, front, side, front, side, f"{height:g}", s.sex])
+            rows.append([photo_id, front, side, front, side, f"{height:g}", s.sex,
+                         f"{s.weight_kg:g}" if args.mass else ""])
     out = RUNS / args.name
     out.mkdir(parents=True, exist_ok=True)
     table = out / "subjects.csv"
@@ -132,15 +134,16 @@ def _main_table(fits: PhotoFits, removed: np.ndarray, baseline: np.ndarray) -> l
     base_mae = np.abs(baseline - fits.truths).mean(0)
     paper = PAPER_TABLE2["front + side + height"]
     lines = [_row(["measurement", "mean abs.", "median", "offset (95 %)", "> 50 mm",
-                   "> 100 mm", "± holds", "after offsets", "height-weight regression",
-                   "BodyM paper, + height"]),
-             _row(["---"] + ["---:"] * 9)]
+                   "> 100 mm", "± holds", "after offsets", "± holds after offsets",
+                   "height-weight regression", "BodyM paper, + height"]),
+             _row(["---"] + ["---:"] * 10)]
     for i, key in enumerate(SHARED_KEYS):
         lines.append(_row([
             f"{key} {MEASUREMENTS[key][1]}", f"{st.mae[i]:.1f}", f"{st.median[i]:.1f}",
             f"{st.offset[i]:+.1f} (±{st.offset_ci[i]:.1f})", f"{100 * st.over_50[i]:.0f} %",
             f"{100 * st.over_100[i]:.0f} %", f"{100 * st.covered[i]:.0f} %",
-            f"**{st.mae_after[i]:.1f}**", _mm(base_mae[i]),
+            f"**{st.mae_after[i]:.1f}**", f"{100 * st.covered_after[i]:.0f} %",
+            _mm(base_mae[i]),
             f"{paper[key]:.1f}" if key in paper else "—"]))
     for label, keys in (("chest, waist, hip", _CHEST_WAIST_HIP), ("all 13", SHARED_KEYS)):
         cols = [SHARED_KEYS.index(k) for k in keys]
@@ -148,7 +151,8 @@ def _main_table(fits: PhotoFits, removed: np.ndarray, baseline: np.ndarray) -> l
             f"*mean of {label}*", f"{st.mae[cols].mean():.1f}", f"{st.median[cols].mean():.1f}",
             "", f"{100 * st.over_50[cols].mean():.0f} %",
             f"{100 * st.over_100[cols].mean():.0f} %", f"{100 * st.covered[cols].mean():.0f} %",
-            f"**{st.mae_after[cols].mean():.1f}**", _mm(base_mae[cols].mean()),
+            f"**{st.mae_after[cols].mean():.1f}**",
+            f"{100 * st.covered_after[cols].mean():.0f} %", _mm(base_mae[cols].mean()),
             f"{np.mean([paper[k] for k in keys]):.1f}" if set(keys) <= set(paper) else "—"]))
     return lines
 
@@ -246,6 +250,8 @@ def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
                             help="each subject's first photo pair, or all of them")
     fit_parser.add_argument("--height", choices=("stated", "scan"), default="stated",
                             help="the stature given: the stated height, or the scan's")
+    fit_parser.add_argument("--mass", action="store_true",
+                            help="give each person's stated weight as the mass (mass_kg)")
     rep = sub.choices["report"]
     rep.add_argument("--offsets-from", metavar="RUN",
                      help="a choice-part run whose mean signed errors are the offsets "

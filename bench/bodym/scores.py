@@ -78,6 +78,7 @@ class MeasurementStats:
         over_50, over_100: share (0-1) of people whose |error| exceeds 50 / 100 mm.
         covered: share (0-1) whose |error| <= the fit's ±.
         mae_after: mean |error - the given offsets|, mm.
+        covered_after: share (0-1) whose |error - the given offsets| <= the fit's ±.
     """
 
     count: int
@@ -89,6 +90,7 @@ class MeasurementStats:
     over_100: np.ndarray
     covered: np.ndarray
     mae_after: np.ndarray
+    covered_after: np.ndarray
 
 
 def measurement_stats(errors: np.ndarray, spreads: np.ndarray,
@@ -101,10 +103,11 @@ def measurement_stats(errors: np.ndarray, spreads: np.ndarray,
         raise ValueError(f"statistics need at least 2 people, got {n}")
     absolute = np.abs(errors)
     t = stats.t.ppf(0.975, n - 1) / np.sqrt(n)
+    after = np.abs(errors - removed_offsets)
     return MeasurementStats(n, absolute.mean(0), np.median(absolute, 0), errors.mean(0),
                             t * errors.std(0, ddof=1), (absolute > 50).mean(0),
                             (absolute > 100).mean(0), (absolute <= spreads).mean(0),
-                            np.abs(errors - removed_offsets).mean(0))
+                            after.mean(0), (after <= spreads).mean(0))
 
 
 def offsets(choice_fits: PhotoFits) -> np.ndarray:

@@ -14,7 +14,8 @@ A UTF-8 CSV file with a header row. Columns (any order, names as written here):
 - ``background_front``, ``background_side`` (optional): the subject's background plates,
   as ``fitter run --background-front/--background-side`` (else the batch's, if any);
 - ``sex`` (optional): female, male or unknown (empty or unknown: the batch's ``--sex``);
-- ``weights`` (optional): a weights preset or a .toml file, as ``--weights``.
+- ``weights`` (optional): a weights preset or a .toml file, as ``--weights``;
+- ``mass_kg`` (optional): the body mass, kilograms, as ``fitter run --mass-kg``.
 
 An empty optional cell means "not given" (the batch's option, if any, applies). Relative
 paths are relative to the folder of SUBJECTS.csv, so a table travels with its photos;
@@ -22,7 +23,8 @@ they are made absolute here. Blank lines are ignored.
 
 Problems of the whole table (unreadable file, a missing, unknown or repeated column)
 are :class:`~bodyfit.common.errors.UserError`; problems of one row (a wrong number of
-cells, an empty required cell, a height that is not a number or not a stature, an unknown
+cells, an empty required cell, a height that is not a number or not a stature, a mass
+that is not a number or not one in kilograms, an unknown
 sex or weights preset, an unsafe or repeated id, a path that does not exist) are
 :class:`BadRow`, which ``fitter batch`` reports and stops on, or skips with
 ``--skip-bad-rows``.
@@ -36,7 +38,7 @@ import re
 from pathlib import Path
 
 from bodyfit.common.errors import UserError
-from bodyfit.fitter.fit.person import SEXES, STATURE_RANGE_CM, PersonInputs
+from bodyfit.fitter.fit.person import MASS_RANGE_KG, SEXES, STATURE_RANGE_CM, PersonInputs
 from bodyfit.fitter.fit.weights import PRESETS
 
 __all__ = ["REQUIRED_COLUMNS", "OPTIONAL_COLUMNS", "RESERVED_IDS", "SubjectRow", "BadRow",
@@ -44,7 +46,7 @@ __all__ = ["REQUIRED_COLUMNS", "OPTIONAL_COLUMNS", "RESERVED_IDS", "SubjectRow",
 
 REQUIRED_COLUMNS = ("id", "front", "side", "height_cm")
 OPTIONAL_COLUMNS = ("camera", "mask_front", "mask_side", "background_front", "background_side",
-                    "sex", "weights")
+                    "sex", "weights", "mass_kg")
 _PATH_COLUMNS = ("front", "side", "camera", "mask_front", "mask_side", "background_front",
                  "background_side")
 #: Names of the batch's own files in OUT, which no subject folder may take.
@@ -165,6 +167,16 @@ def _row(cells: dict[str, str], line: int, folder: Path) -> SubjectRow:
     if not lo <= height_cm <= hi:
         raise ValueError(f"height_cm must be a stature in centimetres, {lo:.0f}-{hi:.0f}; "
                          f"got {height_cm:g}")
+    mass_kg = None
+    if cells.get("mass_kg"):
+        try:
+            mass_kg = float(cells["mass_kg"])
+        except ValueError:
+            raise ValueError(f"mass_kg {cells['mass_kg']!r} is not a number") from None
+        lo, hi = MASS_RANGE_KG
+        if not lo <= mass_kg <= hi:
+            raise ValueError(f"mass_kg must be a body mass in kilograms, {lo:.0f}-{hi:.0f}; "
+                             f"got {mass_kg:g}")
     sex = cells.get("sex") or "unknown"
     if sex not in SEXES:
         raise ValueError(f"sex must be one of {', '.join(SEXES)} (or empty), got {sex!r}")
@@ -184,7 +196,8 @@ def _row(cells: dict[str, str], line: int, folder: Path) -> SubjectRow:
         if not path.is_file():
             raise ValueError(f"weights {weights}: no such file")
         weights = str(path)
-    return SubjectRow(cells["id"], PersonInputs(height_cm=height_cm, sex=sex, **paths),
+    return SubjectRow(cells["id"], PersonInputs(height_cm=height_cm, sex=sex, mass_kg=mass_kg,
+                                                **paths),
                       weights, line)
 
 

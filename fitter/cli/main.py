@@ -60,6 +60,9 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                             help="side photo from the person's left or right, arms hanging down")
         parser.add_argument("--height-cm", type=float, metavar="CM",
                             help="the person's stature, centimetres")
+        parser.add_argument("--mass-kg", type=float, metavar="KG",
+                            help="the person's body mass, kilograms (optional): the "
+                                 "measurements' prior reads it with the stature and sex")
         parser.add_argument("-o", "--output", type=Path, metavar="OUT",
                             help="output folder (created; must be empty unless --overwrite)")
     parser.add_argument("--camera", metavar="camera.json",
@@ -138,10 +141,11 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="the arms' lowest abduction from the rest A-pose (default -25: "
                              "17 degrees from hanging; -10: the default before, and "
                              "--method thorough's and paper's)")
-    parser.add_argument("--elbows", choices=("fitted", "rest"),  # local_solver.ELBOWS
+    parser.add_argument("--elbows", choices=("fitted", "per-photo", "rest"),  # ELBOWS
                         help="the local solver's elbows: fitted (the default: one flexion "
-                             "for both arms and photos, solved with the body) or rest (the "
-                             "model's rest pose's, about 43 degrees)")
+                             "for both arms and photos, solved with the body), per-photo "
+                             "(one flexion in each photo) or rest (the model's rest "
+                             "pose's, about 43 degrees)")
     parser.add_argument("--hands", choices=("fitted", "rest"),  # local_solver.HANDS
                         help="the front photo's hands: fitted (the default: each hand's "
                              "twist about its forearm, from palm in to palm forward, solved "
@@ -152,6 +156,12 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "run again with each camera pitched 4 degrees down and up, the "
                              "best-scored answer kept; about twice the time) or level (both "
                              "cameras level, the default before)")
+    parser.add_argument("--measurement-prior", choices=("ansur", "none"),  # PRIORS
+                        help="ansur (the default): each measurement weighed against what "
+                             "ANSUR II's adults of the stature, sex (and --mass-kg) measure, "
+                             "by its ±, so a fit that matched the silhouettes poorly leans "
+                             "on them; none: the fit's own (the default before; --method "
+                             "thorough's and paper's)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
                              "first K components, --refinements of them, averaged (more "

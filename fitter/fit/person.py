@@ -30,12 +30,15 @@ from bodyfit.fitter.fit.facing import side_seen
 from bodyfit.fitter.fit.pinhole_canvas import (PHONE_HFOV_DEG, phone_intrinsics,
                                                upright_intrinsics)
 
-__all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "checked_photos",
+__all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "MASS_RANGE_KG", "checked_photos",
            "person_masks", "upright_photo", "view_intrinsics", "person_silhouettes"]
 
 #: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
 #: most likely given in other units).
 STATURE_RANGE_CM = (100.0, 250.0)
+#: The body masses ``--mass-kg`` accepts, kilograms (another unit, pounds, is refused
+#: where it falls outside).
+MASS_RANGE_KG = (25.0, 300.0)
 SEXES = ("female", "male", "unknown")
 #: The narrowest front silhouette accepted, as its width over its height: the arms held
 #: out from the body. The mean body at the search's lowest arm abduction
@@ -66,6 +69,8 @@ class PersonInputs:
             :data:`bodyfit.calib.segmenters.SEGMENTERS`.
         check: run the photography check (:mod:`bodyfit.fitter.check.photos`) before
             the fit (``--no-check``: False).
+        mass_kg: the body's mass, kilograms, or None (read by the measurements' prior,
+            :mod:`bodyfit.fitter.fit.measurement_prior`).
     """
 
     front: str
@@ -79,12 +84,17 @@ class PersonInputs:
     sex: str = "unknown"
     segmenter: str = "auto"
     check: bool = True
+    mass_kg: float | None = None
 
     def validate(self) -> None:
         lo, hi = STATURE_RANGE_CM
         if not lo <= self.height_cm <= hi:
             raise UserError(f"--height-cm must be a stature in centimetres, {lo:.0f}-{hi:.0f}; "
                             f"got {self.height_cm:g}")
+        lo, hi = MASS_RANGE_KG
+        if self.mass_kg is not None and not lo <= self.mass_kg <= hi:
+            raise UserError(f"--mass-kg must be a body mass in kilograms, {lo:.0f}-{hi:.0f}; "
+                            f"got {self.mass_kg:g}")
         if self.sex not in SEXES:
             raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
         self.validate_photos()

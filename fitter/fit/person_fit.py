@@ -17,10 +17,11 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
                                        orthographic_view)
-from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
+from bodyfit.fitter.fit.elbows import elbow_forward, view_flexion, view_twist
 from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
+from bodyfit.fitter.fit.measurement_prior import PRIORS, MeasurementPrior, combined
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
 from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew, view_pitch_deg
 from bodyfit.fitter.fit.pitch import PITCH_ITERATIONS, searched_pitches
@@ -80,6 +81,10 @@ class FitSettings:
             :data:`~bodyfit.fitter.fit.photo_extents.SCALED` take their extents from the
             photos (:mod:`bodyfit.fitter.fit.photo_extents`); False: every
             measurement is the fitted mesh's.
+        measurement_prior: one of :data:`~bodyfit.fitter.fit.measurement_prior.PRIORS`:
+            "ansur", the measurements weighed against what ANSUR II's adults of the
+            person's stature, sex (and mass) measure, each by its ± (the module
+            :mod:`bodyfit.fitter.fit.measurement_prior`); "none": the fit's own.
     """
 
     search: SearchSettings = SearchSettings(searches=0, refine_components=0,
@@ -98,6 +103,7 @@ class FitSettings:
     projection: str = "pinhole"
     placement_rounds: int = 2
     photo_extents: bool = True
+    measurement_prior: str = "ansur"
 
     @property
     def learned_start(self) -> bool:
@@ -140,6 +146,9 @@ class FitSettings:
                             f"{self.projection!r}")
         if self.placement_rounds < 0:
             raise UserError(f"placement_rounds must be >= 0, got {self.placement_rounds}")
+        if self.measurement_prior not in PRIORS:
+            raise UserError(f"--measurement-prior must be one of {', '.join(PRIORS)}, got "
+                            f"{self.measurement_prior!r}")
 
 
 #: The methods of ``fitter run --method``: bodyfit's default (the local solver from the
@@ -152,14 +161,16 @@ class FitSettings:
 #: every measurement the fitted mesh's.
 METHODS = {
     "bodyfit": FitSettings(),
-    "thorough": FitSettings(search=SearchSettings(), solver=SolverSettings()),
+    "thorough": FitSettings(search=SearchSettings(), solver=SolverSettings(),
+                            measurement_prior="none"),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False,
                                                searches=1, refine_components=0),
                          solver=SolverSettings(),
                          canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
                          projection="orthographic",
-                         render_cell_mm=0.0, placement_rounds=0, photo_extents=False),
+                         render_cell_mm=0.0, placement_rounds=0, photo_extents=False,
+                         measurement_prior="none"),
 }
 
 
@@ -271,7 +282,7 @@ def _scoring(model: BodyModel, views: dict[str, kernels.ViewTarget], settings: F
 
 def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                    view: kernels.ViewTarget, stature_m: float,
-                   condition_stature: bool, flexion_deg: float | None = None,
+                   condition_stature: bool, flexion_deg: float | dict[str, float] | None = None,
                    twist_deg: np.ndarray | None = None) -> np.ndarray:
     """(V', 3) float64 metres: the body a pinhole view's camera is placed from
     (:func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
@@ -289,7 +300,8 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     conditioning a candidate has its own height, and the camera is placed for it scaled to
     the person's stature.
     """
-    body = elbow_forward(model, betas[None], view.view_pose(pose_deg[None]), flexion_deg,
+    body = elbow_forward(model, betas[None], view.view_pose(pose_deg[None]),
+                         view_flexion(view.name, flexion_deg),
                          view_twist(view.name, twist_deg))[0]
     if not condition_stature:
         body = body * stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
@@ -298,7 +310,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
 
 
 def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
-                  betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None = None,
+                  betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | dict[str, float] | None = None,
                   twist_deg: np.ndarray | None = None,
                   pitches: dict[str, float] | None = None) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
@@ -470,7 +482,7 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         start = np.clip(learned_genes(model, masks, stature_m, sex, solver.components),
                         problem.lower[:problem.num_genes], problem.upper[:problem.num_genes])
 
-    def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None,
+    def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | dict[str, float] | None,
               twist_deg: np.ndarray | None, turned: dict[str, float] | None = None) -> None:
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
                       pose_deg, flexion_deg, twist_deg, turned)
@@ -492,8 +504,8 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         scored = evaluator.evaluate(betas[None], pose[None])
     else:  # the kernels' rig has no elbows or hands: the bodies as the solver posed them
         scored = evaluator.evaluate_posed({
-            name: elbow_forward(problem.model, betas[None], view.view_pose(pose[None]), flexion,
-                                view_twist(name, twist))
+            name: elbow_forward(problem.model, betas[None], view.view_pose(pose[None]),
+                                view_flexion(name, flexion), view_twist(name, twist))
             for name, view in views.items()})
     genes = np.array(trace.genes) if trace.genes else start[None]
     # the solver's cost per iteration; with none (the learned start alone), the start's
@@ -537,7 +549,7 @@ def _pitch_searched(model, views, masks, intrinsics, stature_m, sex: str,
 
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                   views: dict[str, kernels.ViewTarget], stature_m: float,
-                  condition_stature: bool, flexion_deg: float | None = None,
+                  condition_stature: bool, flexion_deg: float | dict[str, float] | None = None,
                   twist_deg: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
     """The fit's bodies of its answer (betas (K,), pose (4,) degrees, elbows' flexion and
     the front photo's hands' twist, each None for the rest pose's; the posed body has the
@@ -545,9 +557,11 @@ def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     (posed (V, 3), rest (V, 3), view name -> (V, 3) in that view's pose), the posed and
     rest bodies rescaled to the stature when the search conditioned it (a posed height
     conditioned, or a first beta at its limit), the view bodies as the search scored them."""
-    posed = elbow_forward(model, betas[None], pose_deg[None], flexion_deg, twist_deg)[0]
+    posed = elbow_forward(model, betas[None], pose_deg[None], view_flexion("front", flexion_deg),
+                          twist_deg)[0]
     view_bodies = {name: elbow_forward(model, betas[None], view.view_pose(pose_deg[None]),
-                                       flexion_deg, view_twist(name, twist_deg))[0]
+                                       view_flexion(name, flexion_deg),
+                                       view_twist(name, twist_deg))[0]
                    for name, view in views.items()}
     rest = rest_shape(model, betas[None])[0][0]
     if condition_stature:
@@ -591,7 +605,8 @@ def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSetti
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                settings: FitSettings = FitSettings(), progress: bool | None = None,
-               intrinsics: dict[str, np.ndarray] | None = None, sex: str = "unknown") -> Fit:
+               intrinsics: dict[str, np.ndarray] | None = None, sex: str = "unknown",
+               mass_kg: float | None = None) -> Fit:
     """Fit the body model to a person's front and side silhouettes.
 
     Args:
@@ -603,7 +618,9 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
         intrinsics: {"front": K, "side": K}, (3, 3) pixels, of the upright photos the masks
             are of; needed by the pinhole projection
             (:func:`bodyfit.fitter.fit.person.view_intrinsics`).
-        sex: "female", "male" or "unknown": read by the learned start only.
+        sex: "female", "male" or "unknown": read by the learned start and the
+            measurements' prior.
+        mass_kg: the body's mass, kilograms, or None: read by the measurements' prior.
     """
     settings.validate(model.num_components)
     if settings.projection == "pinhole" and intrinsics is None:
@@ -641,6 +658,9 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     else:
         spreads, basis = population_spreads(model, measurer, result, stature_m
                                             if s.condition_stature else None), "population"
+    if settings.measurement_prior == "ansur":
+        measurements, spreads = combined(measurements, spreads, *MeasurementPrior.load().predict(
+            sex, 1000.0 * stature_m, mass_kg))
     t3 = time.perf_counter()
     return Fit(result, posed, rest, measurements, spreads, basis, views,
                {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies)
@@ -673,7 +693,7 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
     """
     photos = person_silhouettes(inputs, settings.projection)
     fit = fit_person(model, photos.masks, inputs.height_cm / 100.0, settings, progress,
-                     photos.intrinsics, inputs.sex)
+                     photos.intrinsics, inputs.sex, inputs.mass_kg)
     read = {"camera": photos.camera_source or "orthographic", "side_from": photos.side_from}
     if photos.check is not None:
         read["check_warnings"] = list(photos.check)

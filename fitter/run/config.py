@@ -117,6 +117,15 @@ def _without_solver(settings):
     return settings
 
 
+def _without_prior(settings):
+    """run.json's ``settings`` object with the measurements' prior off when it names none:
+    a run from before the prior (docs/history.md). Anything else is returned as it is, for
+    :func:`_build` to check."""
+    if not isinstance(settings, dict) or "measurement_prior" in settings:
+        return settings
+    return {**settings, "measurement_prior": "none"}
+
+
 def run_config(record: dict, where: str = "run.json") -> RunConfig:
     """The inputs, settings and output folder of a run.json payload.
 
@@ -129,7 +138,8 @@ def run_config(record: dict, where: str = "run.json") -> RunConfig:
         if key not in record:
             raise UserError(f"{where}: missing {key!r}; is it a fitter run's run.json?")
     inputs = _build(PersonInputs, record["inputs"], f"{where}: inputs")
-    settings = _build(FitSettings, _without_solver(_neck_as_head(record["settings"])),
+    settings = _build(FitSettings,
+                      _without_prior(_without_solver(_neck_as_head(record["settings"]))),
                       f"{where}: settings",
                       {"search": SearchSettings, "solver": SolverSettings,
                        "canvas": CanvasSettings, "cost": kernels.CostSettings})

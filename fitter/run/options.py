@@ -23,7 +23,8 @@ __all__ = ["INPUT_OPTIONS", "SEARCH_OPTIONS", "base_settings", "fit_settings"]
 
 #: `fitter run`'s options that are fields of PersonInputs, and of SearchSettings.
 INPUT_OPTIONS = ("front", "side", "height_cm", "camera", "mask_front", "mask_side",
-                 "background_front", "background_side", "sex", "segmenter", "check")
+                 "background_front", "background_side", "sex", "segmenter", "check",
+                 "mass_kg")
 SEARCH_OPTIONS = ("optimizer", "population", "generations", "components", "seed",
                   "searches", "refine_components", "refine_generations", "refinements")
 
@@ -53,7 +54,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     the weights) and ``weight`` (a list of ``NAME=VALUE`` overrides on top)), ``device``,
     ``threads``, ``side_arms``, ``projection``, ``placement_rounds``, ``arms_lower_deg``
     (both shoulders' lowest abduction) and the local solver's
-    ``iterations``, ``start``, ``elbows``, ``hands``, ``placements_within`` and ``pitch``.
+    ``iterations``, ``start``, ``elbows``, ``hands``, ``placements_within`` and ``pitch``,
+    and ``measurement_prior``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -87,4 +89,6 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
                                side_arms=given.get("side_arms", base.side_arms),
                                projection=given.get("projection", base.projection),
                                placement_rounds=given.get("placement_rounds",
-                                                          base.placement_rounds))
+                                                          base.placement_rounds),
+                               measurement_prior=given.get("measurement_prior",
+                                                           base.measurement_prior))

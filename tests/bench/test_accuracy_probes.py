@@ -13,7 +13,7 @@ from accuracy_runs import probe
 
 from bench.accuracy.report import mean_of_important
 from bench.accuracy.runs import read_source
-from bodyfit.fitter.batch.tables import SUMMARY_COLUMNS, SUMMARY_FILE, read_table
+from bodyfit.fitter.batch.tables import SUMMARY_COLUMNS, SUMMARY_FILE, csv_text, read_table
 from bodyfit.fitter.measure.measurements import MEASUREMENTS
 
 
@@ -111,3 +111,30 @@ def test_bends_refuses_a_set_whose_photos_bend_no_limb(small_run, capsys):
         probe(capsys, "bends", str(small_run.set_folder), small_run.name)
     with pytest.raises(SystemExit, match="bend no limb"):
         probe(capsys, "bend-readings", str(small_run.set_folder), small_run.name)
+
+
+def test_the_prior_probe_scores_kept_fits_with_and_without_the_prior(tmp_path):
+    """bench.probes.measurement_prior on a made-up kept setting: a fit with a ± of 1 µm
+    keeps its values; one with a ± of a kilometre takes the prior's."""
+    from bench.accuracy.runs import KEPT_COLUMNS, TRUTH_COLUMNS
+    from bench.probes.measurement_prior import prior_effect
+    from bodyfit.fitter.fit.measurement_prior import MeasurementPrior
+    from bodyfit.fitter.measure.measurements import IMPORTANT
+
+    names = [name for name, _ in MEASUREMENTS.values()]
+    truth = {k: 500.0 + 10 * i for i, k in enumerate(MEASUREMENTS)} | {"O": 1700.0}
+    truths, kept = [], []
+    for i, spread in enumerate((1e-3, 1e6)):
+        subject = f"s{i:04d}-female"
+        truths.append([subject, "female", "False", *[truth[k] for k in MEASUREMENTS]])
+        cells = {"id": subject, "status": "fitted"} | {
+            f"{n}_mm": truth[k] + 10.0 for k, n in zip(MEASUREMENTS, names)} | {
+            f"{n}_spread_mm": spread for n in names}
+        kept.append([cells.get(c, "") for c in KEPT_COLUMNS])
+    (tmp_path / "truths.csv").write_text(csv_text(TRUTH_COLUMNS, truths))
+    (tmp_path / "kept.csv").write_text(csv_text(KEPT_COLUMNS, kept))
+    without, with_prior = prior_effect(tmp_path / "kept.csv", tmp_path / "truths.csv")
+    np.testing.assert_allclose(without, [10.0, 10.0])
+    mean, _ = MeasurementPrior.load().predict("female", 1700.0)
+    expected = np.mean([abs(mean[k] - truth[k]) for k in IMPORTANT])
+    np.testing.assert_allclose(with_prior, [10.0, expected], rtol=1e-6)

@@ -72,6 +72,7 @@ def test_statistics_against_hand_computed_values():
     np.testing.assert_allclose(st.over_100, [0.0, 1 / 3])
     np.testing.assert_allclose(st.covered, [2 / 3, 2 / 3])
     np.testing.assert_allclose(st.mae_after, [20.0, (80 + 100 + 20) / 3])
+    np.testing.assert_allclose(st.covered_after, [2 / 3, 1 / 3])
     # the interval of the offset: Student's t on 2 degrees of freedom
     np.testing.assert_allclose(st.offset_ci[0], 4.302653 * 26.457513 / np.sqrt(3), rtol=1e-5)
     with pytest.raises(ValueError):
@@ -161,3 +162,4 @@ def test_fit_and_report_two_people_end_to_end(tmp_path, monkeypatch, body_model,
     i = SHARED_KEYS.index("D")
     assert f"| D chest circumference | {chest.mae[i]:.1f} | " in text
     assert "Repeat photos (1 subjects with two or more fitted pairs, 3 pairs)" in text
+

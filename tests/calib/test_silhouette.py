@@ -250,6 +250,25 @@ def test_load_mask_reads_user_masks(tmp_path, studio):
         load_mask(tmp_path / "none.png")
 
 
+def test_load_mask_drops_stray_blobs_and_refuses_two_people(tmp_path, studio):
+    _, truth = studio
+    rows, cols = np.nonzero(truth)
+    area = truth.sum()
+    path = tmp_path / "mask.png"
+    # a blob of 3 % of the person beside the feet (a shoe), and a speck in a corner
+    blob = truth.copy()
+    side = int(np.sqrt(0.03 * area))
+    blob[rows.max() - side:rows.max(), cols.max() + 5:cols.max() + 5 + side] = True
+    blob[1:3, 1:3] = True
+    cv2.imwrite(str(path), blob.astype(np.uint8) * 255)
+    np.testing.assert_array_equal(load_mask(path), truth)
+    # a second person-sized region: refused
+    two = np.hstack([truth, truth])
+    cv2.imwrite(str(path), two.astype(np.uint8) * 255)
+    with pytest.raises(UserError, match="2 person-sized regions"):
+        load_mask(path)
+
+
 def test_settings_are_checked():
     with pytest.raises(ValueError, match="odd"):
         SilhouetteSettings(median_px=4)

@@ -245,6 +245,8 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--matching": "both"}, "matching"),
     ({"--side-arms": "up"}, "invalid choice"),
     ({"--threads": "0"}, "--threads"),
+    ({"--mass-kg": "350"}, "--mass-kg must be a body mass in kilograms, 25-300; got 350"),
+    ({"--measurement-prior": "soldiers"}, "invalid choice"),
     ({"--iterations": "-1"}, "--iterations must be >= 0"),
     ({"--iterations": "0", "--start": "mean"}, "--searches 0 needs the local solver"),
     ({"--searches": "1", "--start": "learned"}, "--start learned needs --searches 0"),
