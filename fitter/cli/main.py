@@ -141,11 +141,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="the arms' lowest abduction from the rest A-pose (default -25: "
                              "17 degrees from hanging; -10: the default before, and "
                              "--method thorough's and paper's)")
-    parser.add_argument("--elbows", choices=("fitted", "per-photo", "rest"),  # ELBOWS
+    parser.add_argument("--elbows", choices=("fitted", "rest"),  # local_solver.ELBOWS
                         help="the local solver's elbows: fitted (the default: one flexion "
-                             "for both arms and photos, solved with the body), per-photo "
-                             "(one flexion in each photo) or rest (the model's rest "
-                             "pose's, about 43 degrees)")
+                             "for both arms and photos, solved with the body) or rest (the "
+                             "model's rest pose's, about 43 degrees)")
     parser.add_argument("--hands", choices=("fitted", "rest"),  # local_solver.HANDS
                         help="the front photo's hands: fitted (the default: each hand's "
                              "twist about its forearm, from palm in to palm forward, solved "

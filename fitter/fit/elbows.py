@@ -6,9 +6,9 @@ The model's rest pose (Anny's A-pose) bends each forearm forward at the elbow by
 hips (:mod:`bodyfit.fitter.model.body_model`). So its arms, hung down for a side photo, swing
 their hands in front of the belly, where a person's straight arm lays them against the
 thigh; and in a front photo its forearm is foreshortened towards the camera. The local
-solver fits the elbows' flexion, both arms alike, one for both photos or one per photo
-(``SolverSettings.elbows``, :func:`view_flexion`; the flexion the learned start and the
-search leave is the rest pose's).
+solver fits one elbow flexion for both arms and both photos
+(``SolverSettings.elbows``; the flexion the learned start and the search leave is the
+rest pose's).
 
 The bend: each forearm-and-hand vertex ``v`` turned about its side's elbow, through the
 centroid ``c`` of the elbow ring (linear in the body) about the rest elbow's hinge axis
@@ -48,7 +48,7 @@ from bodyfit.fitter.model.body_model import (PART_NAMES, BodyModel, abduction_ro
 from bodyfit.kernels.body_forward import blend_skinning
 
 __all__ = ["TurnRig", "TWISTED_VIEWS", "elbow_rig", "wrist_rig", "bent", "bend_derivative",
-           "view_twist", "view_flexion", "elbow_forward"]
+           "view_twist", "elbow_forward"]
 
 SIDES = ("L", "R")
 _SMOOTHING_ROUNDS = 6  # neighbour averages of a turned part's weight across its ring
@@ -192,19 +192,6 @@ def view_twist(view_name: str, twist_deg: np.ndarray | None) -> np.ndarray | Non
     """The hands' twists (2,) a view's body is posed with: ``twist_deg`` in the
     ``TWISTED_VIEWS``, None (the rest pose's) in the others."""
     return twist_deg if view_name in TWISTED_VIEWS else None
-
-
-def view_flexion(view_name: str, flexion_deg: float | dict[str, float] | None
-                 ) -> float | None:
-    """The elbows' flexion a view's body is posed with, degrees: ``flexion_deg`` itself
-    (one for both photos, or None: the rest pose's) or, fitted per photo, its entry for
-    the view (view name -> degrees).
-
-    Example:
-        >>> view_flexion("side", {"front": 12.0, "side": 3.0}), view_flexion("side", 12.0)
-        (3.0, 12.0)
-    """
-    return flexion_deg.get(view_name) if isinstance(flexion_deg, dict) else flexion_deg
 
 
 def elbow_forward(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,

@@ -50,7 +50,7 @@ import scipy.ndimage as ndi
 from scipy.spatial import cKDTree
 
 from bodyfit.common.errors import UserError
-from bodyfit.fitter.fit.elbows import elbow_forward, elbow_rig, view_flexion, view_twist
+from bodyfit.fitter.fit.elbows import elbow_forward, elbow_rig, view_twist
 from bodyfit.fitter.fit.outline import OutlineSamples, ViewOutline, moved_camera
 from bodyfit.fitter.fit.pitch import PITCHES
 from bodyfit.fitter.model.body_model import BodyModel
@@ -65,10 +65,9 @@ _KNEE_FALL = 0.8
 #: Where the local solver starts (``SolverSettings.start``); the first is the default.
 SOLVER_STARTS = ("mean", "learned")
 #: How the solver treats the elbows: ``"fitted"``, one flexion for both arms and both
-#: photos solved with the body (:mod:`bodyfit.fitter.fit.elbows`); ``"per-photo"``, one
-#: flexion for both arms in each photo (a side photo's arms hang straighter than the
-#: front's A-pose holds them); ``"rest"``, the rest pose's (the model's rig alone).
-ELBOWS = ("fitted", "per-photo", "rest")
+#: photos solved with the body (:mod:`bodyfit.fitter.fit.elbows`); ``"rest"``, the rest
+#: pose's (the model's rig alone).
+ELBOWS = ("fitted", "rest")
 #: The bounds of a fitted elbow flexion, degrees.
 ELBOW_RANGE_DEG = (0.0, 60.0)
 #: How the solver treats the hands in the front photo: ``"fitted"``, each hand's twist
@@ -249,8 +248,7 @@ class Residuals:
 
 class LocalProblem:
     """One person's smooth cost (the module docstring) over the genes (betas 2..K, the
-    four angles), the elbows' flexion when ``settings.elbows`` fits it (one, or one per
-    view in the views' order), the front
+    four angles), the elbows' flexion when ``settings.elbows`` fits it, the front
     photo's hands' twists (left, right) when ``settings.hands`` fits them, and a camera
     move per view, in that order.
 
@@ -280,33 +278,25 @@ class LocalProblem:
         self.view_weights = {"front": cost.front_weight, "side": cost.side_weight}
         self.names = list(views)
         self.num_genes = self.k - 1 + 4
-        self.rig = elbow_rig(model) if settings.elbows != "rest" else None
-        #: the views whose own flexion the parameters hold (after the genes), in order;
-        #: None: one for all
-        self.flexion_views = list(views) if settings.elbows == "per-photo" else None
-        flexions = 0 if self.rig is None else len(self.flexion_views or [None])
+        self.rig = elbow_rig(model) if settings.elbows == "fitted" else None
         self.fits_twist = settings.hands == "fitted"
         #: where the cameras' moves start in the parameters (after the elbows and the
         #: hands, if fitted)
-        self.camera_start = self.num_genes + flexions + 2 * self.fits_twist
-        turns = np.array([ELBOW_RANGE_DEG] * flexions
+        self.camera_start = self.num_genes + (self.rig is not None) + 2 * self.fits_twist
+        turns = np.array([ELBOW_RANGE_DEG] * (self.rig is not None)
                          + [TWIST_RANGE_DEG] * 2 * self.fits_twist).reshape(-1, 2)
         self.lower = np.r_[np.full(self.k - 1, -beta_limit), pose_lower_deg,
                            turns[:, 0], np.full(3 * len(views), -_CAMERA_REACH_M)]
         self.upper = np.r_[np.full(self.k - 1, beta_limit), pose_upper_deg,
                            turns[:, 1], np.full(3 * len(views), _CAMERA_REACH_M)]
 
-    def start(self, genes: np.ndarray, flexion_deg: float | dict[str, float] | None = None,
+    def start(self, genes: np.ndarray, flexion_deg: float | None = None,
               twist_deg: np.ndarray | None = None) -> np.ndarray:
         """The parameters of ``genes`` (K - 1 + 4,): the elbows at ``flexion_deg`` (None:
-        the rest pose's; one for both photos, or view name -> degrees, as
-        :meth:`body` gives them), the hands at ``twist_deg`` ((2,); None:
-        ``TWIST_START_DEG``), the cameras where they stand."""
-        elbow = []
-        if self.rig is not None:
-            views = self.flexion_views or ["front"]
-            elbow = [self.rig.rest_deg if flexion_deg is None
-                     else view_flexion(name, flexion_deg) for name in views]
+        the rest pose's), the hands at ``twist_deg`` ((2,); None: ``TWIST_START_DEG``),
+        the cameras where they stand."""
+        elbow = ([self.rig.rest_deg if flexion_deg is None else flexion_deg]
+                 if self.rig is not None else [])
         twist = (np.broadcast_to(TWIST_START_DEG if twist_deg is None else twist_deg, 2)
                  if self.fits_twist else [])
         return np.clip(np.r_[genes, elbow, twist, np.zeros(3 * len(self.names))],
@@ -322,19 +312,13 @@ class LocalProblem:
         self.outlines[view.name].view = view
 
     def body(self, x: np.ndarray
-             ) -> tuple[np.ndarray, np.ndarray, float | dict[str, float] | None,
-                        np.ndarray | None]:
-        """(betas (K,), pose (4,) degrees, the elbows' flexion (degrees: one for both
-        photos, or view name -> degrees fitted per photo) and the front photo's hands'
-        twists (2,) in degrees, each None for the rest pose's) of the parameters ``x``."""
+             ) -> tuple[np.ndarray, np.ndarray, float | None, np.ndarray | None]:
+        """(betas (K,), pose (4,) degrees, the elbows' flexion and the front photo's
+        hands' twists (2,) in degrees, each None for the rest pose's) of the parameters
+        ``x``."""
         genes = x[:self.num_genes]
         betas = self.conditioner.complete(genes[None, :self.k - 1], genes[None, self.k - 1:])[0]
-        flexion = None
-        if self.flexion_views is not None:
-            flexion = {name: float(x[self.num_genes + i])
-                       for i, name in enumerate(self.flexion_views)}
-        elif self.rig is not None:
-            flexion = float(x[self.num_genes])
+        flexion = float(x[self.num_genes]) if self.rig is not None else None
         twist = x[self.camera_start - 2:self.camera_start].copy() if self.fits_twist else None
         return betas, genes[self.k - 1:], flexion, twist
 
@@ -357,8 +341,8 @@ class LocalProblem:
         for name, move in self.camera_moves(x).items():
             outline = self.outlines[name]
             view = outline.view
-            posed = elbow_forward(self.model, betas[None], view.view_pose(pose[None]),
-                                  view_flexion(name, flexion), view_twist(name, twist))[0]
+            posed = elbow_forward(self.model, betas[None], view.view_pose(pose[None]), flexion,
+                                  view_twist(name, twist))[0]
             camera = moved_camera(view.camera, move)
             samples = outline.samples(posed.astype(np.float64), camera)
             mm, view_weight = view.millimetres_per_pixel, self.view_weights[name]
@@ -391,24 +375,16 @@ class LocalProblem:
             mm = outline.view.millimetres_per_pixel
             first = self.camera_start + 3 * i
             seen_twist = view_twist(name, twist)
-            d_pixels = outline.jacobian(reading.samples, betas, pose, reading.camera,
-                                        view_flexion(name, flexion), seen_twist)
+            d_pixels = outline.jacobian(reading.samples, betas, pose, reading.camera, flexion,
+                                        seen_twist)
             d_points = np.zeros((len(reading.samples.points), 2, len(x)))
             # columns of d_pixels: K betas, 4 angles, the flexion if fitted, the twists if
-            # fitted and this view's hands turn with them, 3 camera (the other views'
-            # flexions and, where this view's hands do not turn, the twists' columns stay
-            # zero)
-            d_points[:, :, :self.num_genes] = np.concatenate(
+            # fitted and this view's hands turn with them, 3 camera (a view's hands that do
+            # not turn: the twists' columns stay zero)
+            turns = self.camera_start - 2 * (self.fits_twist and seen_twist is None)
+            d_points[:, :, :turns] = np.concatenate(
                 [d_pixels[:, :, 1:self.k] + d_pixels[:, :, :1] * slope[None, None],
-                 d_pixels[:, :, self.k:self.k + 4]], axis=2)
-            column = self.k + 4
-            if self.rig is not None:
-                own = 0 if self.flexion_views is None else self.flexion_views.index(name)
-                d_points[:, :, self.num_genes + own] = d_pixels[:, :, column]
-                column += 1
-            if seen_twist is not None:
-                d_points[:, :, self.camera_start - 2:self.camera_start] = \
-                    d_pixels[:, :, column:column + 2]
+                 d_pixels[:, :, self.k:-3]], axis=2)
             d_points[:, :, first:first + 3] = d_pixels[:, :, -3:]
             if reading.gradients is not None:
                 rows.append(mm * np.einsum("si,sik->sk", reading.gradients, d_points))

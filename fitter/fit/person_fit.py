@@ -17,7 +17,7 @@ from bodyfit import kernels
 from bodyfit.common.errors import UserError
 from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bodies,
                                        orthographic_view)
-from bodyfit.fitter.fit.elbows import elbow_forward, view_flexion, view_twist
+from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
 from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
@@ -282,7 +282,7 @@ def _scoring(model: BodyModel, views: dict[str, kernels.ViewTarget], settings: F
 
 def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                    view: kernels.ViewTarget, stature_m: float,
-                   condition_stature: bool, flexion_deg: float | dict[str, float] | None = None,
+                   condition_stature: bool, flexion_deg: float | None = None,
                    twist_deg: np.ndarray | None = None) -> np.ndarray:
     """(V', 3) float64 metres: the body a pinhole view's camera is placed from
     (:func:`~bodyfit.fitter.fit.pinhole_canvas.placed_anew`) for a candidate (betas (K,), pose
@@ -300,8 +300,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     conditioning a candidate has its own height, and the camera is placed for it scaled to
     the person's stature.
     """
-    body = elbow_forward(model, betas[None], view.view_pose(pose_deg[None]),
-                         view_flexion(view.name, flexion_deg),
+    body = elbow_forward(model, betas[None], view.view_pose(pose_deg[None]), flexion_deg,
                          view_twist(view.name, twist_deg))[0]
     if not condition_stature:
         body = body * stature_scale(rest_shape(model, betas[None])[0][0], stature_m)
@@ -310,7 +309,7 @@ def placement_body(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
 
 
 def place_cameras(model, views, masks, intrinsics, stature_m, evaluator, settings,
-                  betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | dict[str, float] | None = None,
+                  betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None = None,
                   twist_deg: np.ndarray | None = None,
                   pitches: dict[str, float] | None = None) -> None:
     """Place every view's pinhole camera anew from the candidate (betas (K,), pose (4,)
@@ -482,7 +481,7 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         start = np.clip(learned_genes(model, masks, stature_m, sex, solver.components),
                         problem.lower[:problem.num_genes], problem.upper[:problem.num_genes])
 
-    def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | dict[str, float] | None,
+    def place(betas: np.ndarray, pose_deg: np.ndarray, flexion_deg: float | None,
               twist_deg: np.ndarray | None, turned: dict[str, float] | None = None) -> None:
         place_cameras(model, views, masks, intrinsics, stature_m, evaluator, at_k, betas,
                       pose_deg, flexion_deg, twist_deg, turned)
@@ -504,8 +503,8 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
         scored = evaluator.evaluate(betas[None], pose[None])
     else:  # the kernels' rig has no elbows or hands: the bodies as the solver posed them
         scored = evaluator.evaluate_posed({
-            name: elbow_forward(problem.model, betas[None], view.view_pose(pose[None]),
-                                view_flexion(name, flexion), view_twist(name, twist))
+            name: elbow_forward(problem.model, betas[None], view.view_pose(pose[None]), flexion,
+                                view_twist(name, twist))
             for name, view in views.items()})
     genes = np.array(trace.genes) if trace.genes else start[None]
     # the solver's cost per iteration; with none (the learned start alone), the start's
@@ -549,7 +548,7 @@ def _pitch_searched(model, views, masks, intrinsics, stature_m, sex: str,
 
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
                   views: dict[str, kernels.ViewTarget], stature_m: float,
-                  condition_stature: bool, flexion_deg: float | dict[str, float] | None = None,
+                  condition_stature: bool, flexion_deg: float | None = None,
                   twist_deg: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
     """The fit's bodies of its answer (betas (K,), pose (4,) degrees, elbows' flexion and
     the front photo's hands' twist, each None for the rest pose's; the posed body has the
@@ -557,11 +556,9 @@ def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,
     (posed (V, 3), rest (V, 3), view name -> (V, 3) in that view's pose), the posed and
     rest bodies rescaled to the stature when the search conditioned it (a posed height
     conditioned, or a first beta at its limit), the view bodies as the search scored them."""
-    posed = elbow_forward(model, betas[None], pose_deg[None], view_flexion("front", flexion_deg),
-                          twist_deg)[0]
+    posed = elbow_forward(model, betas[None], pose_deg[None], flexion_deg, twist_deg)[0]
     view_bodies = {name: elbow_forward(model, betas[None], view.view_pose(pose_deg[None]),
-                                       view_flexion(name, flexion_deg),
-                                       view_twist(name, twist_deg))[0]
+                                       flexion_deg, view_twist(name, twist_deg))[0]
                    for name, view in views.items()}
     rest = rest_shape(model, betas[None])[0][0]
     if condition_stature:

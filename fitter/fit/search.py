@@ -172,8 +172,7 @@ class SearchResult:
         averaged_from: the results whose answers were averaged into this one
             (:func:`averaged`; after :func:`refined`, the refinements'); () for one search.
         elbow_deg: the elbows' flexion of the answer, degrees (the local solver's
-            ``elbows="fitted"``; with ``"per-photo"``, view name -> degrees); None: the
-            rest pose's.
+            ``elbows="fitted"``); None: the rest pose's.
         hand_twist_deg: (2,) the front photo's left and right hands' twists of the answer,
             degrees (the local solver's ``hands="fitted"``; 0 palm in, 90 palm forward);
             None: the rest pose's.
@@ -193,7 +192,7 @@ class SearchResult:
     seconds: float
     stop_reasons: dict
     averaged_from: tuple["SearchResult", ...] = ()
-    elbow_deg: float | dict[str, float] | None = None
+    elbow_deg: float | None = None
     hand_twist_deg: np.ndarray | None = None
 
 

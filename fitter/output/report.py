@@ -95,11 +95,7 @@ def _settings_rows(record: dict) -> list[tuple[str, str]]:
                                   f"{_e(solver['components'])} components"
                                   + (", from the learned start" if learned else "")
                                   + ("" if elbows is None else
-                                     f"; the elbows fitted, {elbows:.1f} degrees"
-                                     if not isinstance(elbows, dict) else
-                                     "; the elbows fitted per photo, " + ", ".join(
-                                         f"{view} {deg:.1f}" for view, deg in elbows.items())
-                                     + " degrees")
+                                     f"; the elbows fitted, {elbows:.1f} degrees")
                                   + ("" if hands is None else
                                      "; the front photo's hands turned {} and {} degrees "
                                      "from palm in".format(*map(round, hands.values())))

@@ -103,17 +103,15 @@ def test_outline_jacobian_matches_finite_differences(body_model, subject, name):
         assert not jacobian[:, :, 20:22].any()
 
 
-@pytest.mark.parametrize("flexion, twist", [(None, None), (8.0, None), (8.0, 70.0),
-                                            ({"front": 12.0, "side": 2.0}, None)])
+@pytest.mark.parametrize("flexion, twist", [(None, None), (8.0, None), (8.0, 70.0)])
 def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, subject,
                                                          flexion, twist):
     """The analytic case: the silhouettes are a body's own renders through the views'
     cameras, the body one of the solver's candidates (10 components; its elbows the rest
-    pose's, or bent to 8 degrees and fitted, or bent 12 degrees in the front photo and 2
-    in the side one and fitted per photo; its front photo's hands the rest pose's, or
+    pose's, or bent to 8 degrees and fitted; its front photo's hands the rest pose's, or
     turned 70 degrees towards palms forward and fitted); from the mean body, the solver
     finds its shape and pose (and flexion, and twist) again."""
-    from bodyfit.fitter.fit.elbows import elbow_forward, view_flexion, view_twist
+    from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
 
     folder, truth = subject
     model = render_model(body_model, 8.0)
@@ -127,8 +125,8 @@ def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, s
         mean = forward(model, np.zeros((1, k)), np.zeros((1, 4)))[0]
         placed = pinhole_view(name, person_mask(folder / f"{name}.png"), K_TRUE, stature,
                               extent.reshape(-1, 3), mean, model.vertex_parts, **options)
-        body = elbow_forward(model, betas[None], placed.view_pose(POSE[None]),
-                             view_flexion(name, flexion), view_twist(name, twist))[0]
+        body = elbow_forward(model, betas[None], placed.view_pose(POSE[None]), flexion,
+                             view_twist(name, twist))[0]
         faces, parts = visible_faces(model.faces, model.face_parts, placed.visible_parts)
         own = rasterize(body[None], faces, parts, placed.camera, placed.height,
                         placed.width).numpy()[0] >= 0
@@ -136,8 +134,7 @@ def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, s
                                           placed.millimetres_per_pixel, **options)
     conditioner = StatureConditioner(body_model, k, stature, 3.0, extent)
     settings = SolverSettings(iterations=40, components=k, placements=0,
-                              elbows="rest" if flexion is None else
-                              "per-photo" if isinstance(flexion, dict) else "fitted",
+                              elbows="rest" if flexion is None else "fitted",
                               hands="rest" if twist is None else "fitted")
     problem = LocalProblem(model, views, cost_settings("bodyfit"), conditioner, k,
                            (-10.0,) * 4, (30.0,) * 4, 3.0, settings)
