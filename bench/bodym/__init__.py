@@ -1,4 +1,4 @@
-"""The real-people benchmark (issue 72, docs/accuracy.md "Real people"): BodyM's real
+"""The real-people benchmark (issue 72, docs/accuracy.md "Real people (BodyM)"): BodyM's
 adults' silhouettes fitted through ``fitter batch``, scored against their 3D scans.
 
 - :mod:`.dataset`: the split on disk, its subjects, their fixed order and parts;

@@ -1,6 +1,7 @@
 """The real-people benchmark's commands: BodyM's silhouettes through ``fitter batch``.
 
-Run from the repository root (docs/accuracy.md, "Real people", holds what they measured)::
+Run from the repository root (what they measured: docs/accuracy.md, "Real people
+(BodyM)")::
 
     # the choice part's first 100 subjects (their first photo pair), the default method;
     # fitter batch options after -- (resumable: rerun to continue, or to fit more rows)

@@ -153,30 +153,28 @@ def _check_header(path: Path, header: list[str]) -> None:
                         f"{', '.join(missing)} (required: {', '.join(REQUIRED_COLUMNS)})")
 
 
+def _quantity(cells: dict[str, str], column: str, what: str, bounds) -> float:
+    """The number in ``column``, which must be ``what`` within ``bounds`` (low, high);
+    raises ValueError with the row's problem."""
+    try:
+        value = float(cells[column])
+    except ValueError:
+        raise ValueError(f"{column} {cells[column]!r} is not a number") from None
+    lo, hi = bounds
+    if not lo <= value <= hi:
+        raise ValueError(f"{column} must be {what}, {lo:.0f}-{hi:.0f}; got {value:g}")
+    return value
+
+
 def _row(cells: dict[str, str], line: int, folder: Path) -> SubjectRow:
     """A good row from its cells (id checked by the caller); raises ValueError with the
     row's problem."""
     for name in REQUIRED_COLUMNS[1:]:
         if not cells[name]:
             raise ValueError(f"no {name}")
-    try:
-        height_cm = float(cells["height_cm"])
-    except ValueError:
-        raise ValueError(f"height_cm {cells['height_cm']!r} is not a number") from None
-    lo, hi = STATURE_RANGE_CM
-    if not lo <= height_cm <= hi:
-        raise ValueError(f"height_cm must be a stature in centimetres, {lo:.0f}-{hi:.0f}; "
-                         f"got {height_cm:g}")
-    mass_kg = None
-    if cells.get("mass_kg"):
-        try:
-            mass_kg = float(cells["mass_kg"])
-        except ValueError:
-            raise ValueError(f"mass_kg {cells['mass_kg']!r} is not a number") from None
-        lo, hi = MASS_RANGE_KG
-        if not lo <= mass_kg <= hi:
-            raise ValueError(f"mass_kg must be a body mass in kilograms, {lo:.0f}-{hi:.0f}; "
-                             f"got {mass_kg:g}")
+    height_cm = _quantity(cells, "height_cm", "a stature in centimetres", STATURE_RANGE_CM)
+    mass_kg = (_quantity(cells, "mass_kg", "a body mass in kilograms", MASS_RANGE_KG)
+               if cells.get("mass_kg") else None)
     sex = cells.get("sex") or "unknown"
     if sex not in SEXES:
         raise ValueError(f"sex must be one of {', '.join(SEXES)} (or empty), got {sex!r}")
