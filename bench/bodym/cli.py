@@ -168,7 +168,8 @@ def _paired(fits: PhotoFits, other: PhotoFits, removed: np.ndarray,
     err_a = np.abs(fits.errors[[a[p] for p in shared]] - removed)
     err_b = np.abs(other.errors[[b[p] for p in shared]] - removed_other)
     lines = [f"Paired on the {len(shared)} photo pairs both fitted, mean |error after "
-             "offsets| (mm), this run against the other, and the difference (95 %):", ""]
+             "offsets| (mm; each run's own offsets, or both --offsets-from's), this run "
+             "against the other, and the difference (95 %):", ""]
     groups = [(f"{k} {MEASUREMENTS[k][1]}", (k,)) for k in SHARED_KEYS] + [
         ("chest, waist, hip", _CHEST_WAIST_HIP), ("all 13", SHARED_KEYS)]
     lines += [_row(["measurement", "this run", "the other", "difference"]),
