@@ -20,8 +20,8 @@ from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bod
 from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
 from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
-from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
 from bodyfit.fitter.fit.measurement_prior import PRIORS, MeasurementPrior, combined
+from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
 from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew, view_pitch_deg
 from bodyfit.fitter.fit.pitch import PITCH_ITERATIONS, searched_pitches
