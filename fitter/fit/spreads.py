@@ -53,9 +53,10 @@ __all__ = ["SPREAD_BASES", "SPREAD_NOTES", "CALIBRATION_FILE", "CALIBRATION_FORM
 SPREAD_BASES = ("calibrated", "solver", "population")
 #: What each kind of ± means, in a sentence for the report and the command line.
 SPREAD_NOTES = {
-    "calibrated": "the ± held the truth for 68 % of the accuracy benchmark's people as "
-                  "they stand (synthetic photos), scaled by how well this fit matched the "
-                  "silhouettes; real photos may err more",
+    "calibrated": "the fit's ± held the truth for 68 % of the accuracy benchmark's people "
+                  "as they stand (synthetic photos), scaled by how well this fit matched the "
+                  "silhouettes, then weighed with what ANSUR II's adults of this stature "
+                  "measure; real photos may err more",
     "solver": "the ± is the default method's calibration applied to this fit's cost; "
               "for these settings it is not checked against the truth",
     "population": "the ± is the measurement's standard deviation over the best quarter of "
