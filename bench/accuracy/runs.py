@@ -25,8 +25,8 @@ import numpy as np
 
 from bench.accuracy.scores import KEYS, RunScores
 from bodyfit.fitter.batch.orchestration import BATCH_FILE
-from bodyfit.fitter.batch.tables import (FAILURES_FILE, SUMMARY_COLUMNS, SUMMARY_FILE,
-                                         csv_text, read_table)
+from bodyfit.fitter.batch.tables import (FAILURES_FILE, MEASURED_COLUMNS, SUMMARY_COLUMNS,
+                                         SUMMARY_FILE, csv_text, read_table)
 from bodyfit.fitter.fit.spreads import recorded_answer_cost
 from bodyfit.fitter.measure.measurements import MEASUREMENTS
 from bodyfit.fitter.output.result_files import write_text
@@ -36,9 +36,10 @@ __all__ = ["KEPT_COLUMNS", "TRUTH_COLUMNS", "TRUTHS_FILE", "FITTED", "subject_ro
            "record_holders", "source_timing", "read_truths", "keep_run"]
 
 _NAMES = [name for name, _ in MEASUREMENTS.values()]
-#: A kept setting's columns: summary.csv's, then the fit's answer cost (weighted mm,
-#: :func:`~bodyfit.fitter.fit.spreads.recorded_answer_cost`) and a failure's reason.
-KEPT_COLUMNS = SUMMARY_COLUMNS + ["answer_cost", "reason"]
+#: A kept setting's columns: summary.csv's but its warning, then the fit's answer cost
+#: (weighted mm, :func:`~bodyfit.fitter.fit.spreads.recorded_answer_cost`) and a failure's
+#: reason.
+KEPT_COLUMNS = MEASURED_COLUMNS + ["answer_cost", "reason"]
 #: truths.csv's columns: the subject, its sex, whether it was drawn from the out-of-space
 #: hard share, and its 16 true measurements (mm, the names of measurements.json).
 TRUTH_COLUMNS = ["id", "sex", "hard"] + [f"{name}_mm" for name in _NAMES]

@@ -5,7 +5,9 @@
 to written results, in the batch that fitted it), then each of the 16 measurements'
 value and spread, millimetres (``chest_circumference_mm``,
 ``chest_circumference_spread_mm``, ...: the names of measurements.json), read back from
-OUT/<id>/. The status is one of ``STATUSES``:
+OUT/<id>/, and ``warning``: the fit's warning that it matched the silhouettes poorly
+(run.json's ``photos.fit_warning``; empty for a sound fit). The status is one of
+``STATUSES``:
 
 - ``fitted``: fitted by this run; ``fitted earlier``: OUT/<id>/ was complete already;
 - ``failed``: failed in this run; ``failed earlier``: failed in an earlier run and not
@@ -34,15 +36,19 @@ from bodyfit.fitter.measure.measurements import MEASUREMENTS
 from bodyfit.fitter.output.result_files import write_text
 from bodyfit.fitter.run.results import RUN_FILES
 
-__all__ = ["SUMMARY_FILE", "FAILURES_FILE", "STATUSES", "SUMMARY_COLUMNS", "FAILURES_COLUMNS",
+__all__ = ["SUMMARY_FILE", "FAILURES_FILE", "STATUSES", "MEASURED_COLUMNS", "SUMMARY_COLUMNS",
+           "FAILURES_COLUMNS",
            "SummaryRow", "PreviousBatch", "missing_results", "summary_row", "csv_text",
            "write_tables", "read_table", "read_previous"]
 
 SUMMARY_FILE, FAILURES_FILE = "summary.csv", "failures.csv"
 STATUSES = ("fitted", "fitted earlier", "failed", "failed earlier", "bad row", "not run")
 _NAMES = [name for name, _ in MEASUREMENTS.values()]
-SUMMARY_COLUMNS = ["id", "status", "best_cost", "seconds"] + [
+#: summary.csv's columns before the warning: the subject, its status, cost, time and
+#: measurements (what the accuracy benchmark keeps of a run).
+MEASURED_COLUMNS = ["id", "status", "best_cost", "seconds"] + [
     column for name in _NAMES for column in (f"{name}_mm", f"{name}_spread_mm")]
+SUMMARY_COLUMNS = MEASURED_COLUMNS + ["warning"]
 FAILURES_COLUMNS = ["id", "reason"]
 
 
@@ -52,6 +58,7 @@ class SummaryRow:
 
     Attributes:
         measurements: measurement name -> (value, spread), mm; empty unless fitted.
+        warning: the fit's poor-match warning, or "".
     """
 
     subject_id: str
@@ -60,6 +67,7 @@ class SummaryRow:
     seconds: float | None = None
     measurements: dict[str, tuple[float, float]] = dataclasses.field(default_factory=dict)
     reason: str = ""
+    warning: str = ""
 
 
 def missing_results(folder: Path) -> list[str]:
@@ -73,12 +81,14 @@ def summary_row(folder: Path, status: str, seconds: float | None) -> SummaryRow:
     (measurements.json, run.json); unreadable results give a row without values."""
     try:
         table = json.loads((folder / "measurements.json").read_text())["measurements"]
-        best_cost = float(json.loads((folder / "run.json").read_text())["result"]["best_cost"])
+        record = json.loads((folder / "run.json").read_text())
+        best_cost = float(record["result"]["best_cost"])
         values = {name: (float(table[name]["value_mm"]), float(table[name]["spread_mm"]))
                   for name in _NAMES}
-    except (OSError, ValueError, KeyError, TypeError):
+        warning = str(record.get("photos", {}).get("fit_warning", ""))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return SummaryRow(folder.name, status, seconds=seconds)
-    return SummaryRow(folder.name, status, best_cost, seconds, values)
+    return SummaryRow(folder.name, status, best_cost, seconds, values, warning=warning)
 
 
 def _number(value: float | None, digits: int | None = None) -> str:
@@ -105,7 +115,7 @@ def write_tables(out_dir: Path, rows: list[SummaryRow]) -> tuple[Path, Path]:
         for name in _NAMES:
             value, spread = row.measurements.get(name, (None, None))
             cells += [_number(value, 2), _number(spread, 2)]
-        summary.append(cells)
+        summary.append(cells + [row.warning])
     failures = [[row.subject_id, row.reason] for row in rows
                 if row.status in ("failed", "failed earlier", "bad row")]
     paths = out_dir / SUMMARY_FILE, out_dir / FAILURES_FILE

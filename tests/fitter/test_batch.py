@@ -412,3 +412,29 @@ def test_a_rows_background_plates_replace_the_batchs(tmp_path):
     assert (a.background_front, a.background_side) == (str(tmp_path / "plate_f.png"),
                                                        "/studio/side.png")
     assert (b.background_front, b.background_side) == ("/studio/front.png", "/studio/side.png")
+
+
+def test_summary_rows_carry_each_fits_poor_match_warning(tmp_path):
+    """summary.csv's ``warning``: run.json's ``photos.fit_warning``, empty for a sound fit;
+    a subject without readable results gets a row without values."""
+    from bodyfit.fitter.batch.tables import SUMMARY_COLUMNS, summary_row, write_tables
+    from bodyfit.fitter.measure.measurements import MEASUREMENTS
+
+    table = {name: {"value_mm": 100.0 + i, "spread_mm": 2.0}
+             for i, (name, _) in enumerate(MEASUREMENTS.values())}
+    rows = []
+    for subject, photos in (("sound", {}), ("poor", {"fit_warning": "matches poorly"})):
+        folder = tmp_path / subject
+        folder.mkdir()
+        (folder / "measurements.json").write_text(json.dumps({"measurements": table}))
+        (folder / "run.json").write_text(json.dumps({"result": {"best_cost": 50.0},
+                                                     "photos": photos}))
+        rows.append(summary_row(folder, "fitted", 3.0))
+    (tmp_path / "broken").mkdir()
+    rows.append(summary_row(tmp_path / "broken", "fitted", 3.0))
+    write_tables(tmp_path, rows)
+    written = summary(tmp_path)
+    assert list(written[0]) == SUMMARY_COLUMNS
+    assert [row["warning"] for row in written] == ["", "matches poorly", ""]
+    assert written[1]["chest_circumference_mm"] == "103.00"
+    assert written[2]["chest_circumference_mm"] == ""
