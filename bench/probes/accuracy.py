@@ -52,7 +52,7 @@ from bodyfit.fitter.batch.orchestration import BATCH_FILE
 from bodyfit.fitter.batch.tables import (SUMMARY_COLUMNS, SUMMARY_FILE, SummaryRow, read_table,
                                          summary_row, write_tables)
 from bodyfit.fitter.demo.studio_photos import pinhole_silhouette
-from bodyfit.fitter.fit.person_fit import METHODS
+from bodyfit.fitter.fit.person_fit import METHODS, reported_measurements
 from bodyfit.fitter.fit.photo_extents import SCALED
 from bodyfit.fitter.fit.spreads import (bodyfit_calibration, calibration_applies,
                                         recorded_answer_cost)
@@ -70,10 +70,11 @@ def remeasure(args) -> None:
     """Each fit of a run (a name or a folder, :func:`~bench.accuracy.runs.run_folder`)
     measured again by today's code, as `fitter run` measures its answer now
     (:func:`bodyfit.fitter.fit.person_fit.fitted_measurements`: the answer's body and the subject's
-    photos in the set), into the new run SET/runs/TO/: each record kept, measurements.json
-    and summary.csv written anew with the ± of today's calibration where it applies (the
-    run's own ± otherwise). A change of the measuring alone needs no fit again: the
-    search's answer does not depend on it."""
+    photos in the set, then :func:`~bodyfit.fitter.fit.person_fit.reported_measurements`),
+    into the new run SET/runs/TO/: each record kept, measurements.json and summary.csv
+    written anew with the ± of today's calibration where it applies (the run's own ±
+    otherwise). A change of the measuring alone needs no fit again: the search's answer
+    does not depend on it."""
     folder = Path(args.set)
     source, out = run_folder(folder, args.name), folder / "runs" / args.to
     model = load_model()
@@ -92,13 +93,19 @@ def remeasure(args) -> None:
         _, values, _ = photos.measure(model, measurer, np.array(record["result"]["betas"]),
                                       answer_pose(record))
         written = json.loads((source / subject / "measurements.json").read_text())
+        basis = written.get("spread_basis", "population")
         if calibration_applies(photos.settings, METHODS["bodyfit"]):
-            spreads = bodyfit_calibration().spreads(recorded_answer_cost(record))
             basis = "calibrated"
+        if basis in ("calibrated", "solver"):  # the default's factors, as fit_person gives
+            spreads = bodyfit_calibration().spreads(recorded_answer_cost(record))
         else:
             spreads = {key: written["measurements"][name]["spread_mm"]
                        for key, (name, _) in MEASUREMENTS.items()}
-            basis = written.get("spread_basis", "population")
+        person = record["inputs"]
+        values, spreads = reported_measurements(photos.settings, values, spreads,
+                                                person.get("sex", "unknown"),
+                                                person["height_cm"] / 100.0,
+                                                person.get("mass_kg"))
         (out / subject).mkdir(exist_ok=True)
         (out / subject / "run.json").write_text(json.dumps(record, indent=1))
         write_fitted_measurements(out / subject / "measurements.json", values, spreads, basis,

@@ -38,7 +38,8 @@ from bodyfit.fitter.model.body_model import POSE_NAMES, BodyModel, forward, rest
 from bodyfit.kernels.target import visible_vertices
 
 __all__ = ["FitSettings", "METHODS", "Fit", "fit_person", "fit_inputs", "fit_work",
-           "fitted_bodies", "fitted_measurements", "check_learned_start", "learned_genes",
+           "fitted_bodies", "fitted_measurements", "reported_measurements",
+           "check_learned_start", "learned_genes",
            "person_views", "place_cameras", "placement_body", "refinement_scoring",
            "stature_conditioner", "view_photos"]
 
@@ -595,6 +596,20 @@ def fitted_measurements(model: BodyModel, measurer: Measurer, settings: FitSetti
     return measurements
 
 
+def reported_measurements(settings: FitSettings, measurements: dict[str, float],
+                          spreads: dict[str, float], sex: str, stature_m: float,
+                          mass_kg: float | None) -> tuple[dict[str, float], dict[str, float]]:
+    """(key -> mm, key -> mm): the measurements and ± a fit reports, from the fitted
+    body's ``measurements`` (:func:`fitted_measurements`) and their ``spreads``: weighed
+    against the measurements' prior for the person's sex, stature (metres) and mass (kg or
+    None) when ``settings.measurement_prior`` is "ansur"
+    (:mod:`bodyfit.fitter.fit.measurement_prior`), else as they are."""
+    if settings.measurement_prior == "none":
+        return measurements, spreads
+    return combined(measurements, spreads,
+                    *MeasurementPrior.load().predict(sex, 1000.0 * stature_m, mass_kg))
+
+
 # One BLAS thread for the whole fit: its matrices are small (CMA-ES's 24 x 24, the
 # conditioner's, the forward's), and OpenBLAS's idle threads spin on the cores the
 # kernels' threads evaluate the population on (one fit: 22.5 -> 14.9 s with the search
@@ -655,9 +670,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     else:
         spreads, basis = population_spreads(model, measurer, result, stature_m
                                             if s.condition_stature else None), "population"
-    if settings.measurement_prior == "ansur":
-        measurements, spreads = combined(measurements, spreads, *MeasurementPrior.load().predict(
-            sex, 1000.0 * stature_m, mass_kg))
+    measurements, spreads = reported_measurements(settings, measurements, spreads, sex,
+                                                  stature_m, mass_kg)
     t3 = time.perf_counter()
     return Fit(result, posed, rest, measurements, spreads, basis, views,
                {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies)

@@ -117,7 +117,7 @@ def test_straight_hanging_arms_are_fitted_with_their_length(body, body_model, me
     shot = Shot(3.0, 1.1)
     inputs, truth = _photographed(body, body_model, measurer, tmp_path,
                                   {"front": shot, "side": shot})
-    settings = FitSettings()
+    settings = FitSettings(measurement_prior="none")  # the fits' own measurements
     fits = {elbows: fit_inputs(body_model, inputs, dataclasses.replace(
         settings, solver=dataclasses.replace(settings.solver, elbows=elbows)), progress=False)
         for elbows in ("fitted", "rest")}

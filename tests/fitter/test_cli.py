@@ -30,7 +30,8 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     import shlex
 
     from bodyfit.fitter.demo.example import DemoSettings, demo_camera
-    from bodyfit.fitter.fit.spreads import SPREAD_NOTES
+    from bodyfit.fitter.fit.measurement_prior import MeasurementPrior, combined
+    from bodyfit.fitter.fit.spreads import SPREAD_NOTES, bodyfit_calibration, recorded_answer_cost
     from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
     from bodyfit.fitter.model.body_model import rest_shape
     from bodyfit.fitter.run.results import RUN_FILES
@@ -76,13 +77,19 @@ def test_demo_calibrates_fits_and_measures_against_the_truth(body_model, measure
     spreads = {row["letter"]: row["spread_mm"] for row in written["measurements"].values()}
     assert fitted["O"] == pytest.approx(truth["O"], abs=0.6)  # given in cm to 1 decimal
     # the mesh's measurements but for the girths scaled to the photos, which move by less
-    # than their bound (photo_extents: the fit's pinhole views take them)
+    # than their bound (photo_extents: the fit's pinhole views take them), each weighed
+    # against the prior for the person's stature by the calibrated ± of the fit's cost
     mesh = measurer.measure(read_mesh(out_dir / "fit" / "mesh_rest.ply", body_model.faces))
+    own = bodyfit_calibration().spreads(recorded_answer_cost(record))
+    person = record["inputs"]
+    expected, expected_spreads = combined(mesh, own, *MeasurementPrior.load().predict(
+        person["sex"], 10.0 * person["height_cm"], person["mass_kg"]))
     for key in MEASUREMENTS:
+        assert spreads[key] == pytest.approx(expected_spreads[key], abs=0.01), key
         if key in SCALED:
             assert abs(fitted[key] / mesh[key] - 1) < MAX_CHANGE, key
         else:
-            assert fitted[key] == pytest.approx(mesh[key], abs=0.01), key
+            assert fitted[key] == pytest.approx(expected[key], abs=0.01), key
     # the printed table: 16 rows of fitted, ±, true and error, then the important ones'
     # mean; the ±'s kind named (the default method's: calibrated)
     rows = re.findall(r"^  ([A-P]) .+? +(-?\d+\.\d) +(\d+\.\d) +(-?\d+\.\d) +([+-]\d+\.\d)$",
