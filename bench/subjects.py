@@ -1,5 +1,5 @@
-"""What the fitter benchmarks share: drawing in-space subjects, fitting them by command,
-their errors' table cells.
+"""What the fitter benchmarks share: the bodyfit commands, drawing in-space subjects,
+fitting them by command, their errors' table cells.
 
 Imported by :mod:`bench.fitter_speed`, :mod:`bench.choices`, :mod:`bench.cameras`,
 :mod:`bench.side_arms` and :mod:`bench.batch_speed`.
@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -16,11 +17,18 @@ import numpy as np
 
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
 
-__all__ = ["ERROR_HEADER", "draw_subject", "fit_by_command", "fit_each_setting", "error_cells",
+__all__ = ["ERROR_HEADER", "bodyfit_command", "draw_subject", "fit_by_command", "fit_each_setting", "error_cells",
            "settings_table"]
 
 #: The Markdown header cells of :func:`error_cells`.
 ERROR_HEADER = "7 important, mean abs. error (mm) | " + " | ".join(IMPORTANT) + " | O"
+
+
+def bodyfit_command(name: str) -> str:
+    """The bodyfit command ``name`` ("fitter", "calib") of this Python's environment
+    (found even when the environment is not activated), else the one on PATH."""
+    beside = Path(sys.executable).parent / name
+    return str(beside) if beside.exists() else name
 
 
 def draw_subject(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -35,7 +43,7 @@ def fit_by_command(folder: Path, truth: dict[str, float], out: Path,
     `fitter run` command itself, start-up included; return (wall seconds, the 16 errors
     fitted - true in ``MEASUREMENTS`` order, mm)."""
     start = time.perf_counter()
-    subprocess.run(["fitter", "-q", "run", "--front", str(folder / f"front{photo_suffix}"),
+    subprocess.run([bodyfit_command("fitter"), "-q", "run", "--front", str(folder / f"front{photo_suffix}"),
                     "--side", str(folder / f"side{photo_suffix}"),
                     "--height-cm", f"{truth['O'] / 10:.2f}",
                     "-o", str(out), *options], check=True, stdout=subprocess.DEVNULL)

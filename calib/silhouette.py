@@ -282,6 +282,14 @@ def _components(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return labels, stats[1:]
 
 
+def _largest_region(areas: np.ndarray, settings: SilhouetteSettings) -> tuple[int, int]:
+    """(index of the largest of the regions' ``areas`` (n,), n >= 1; how many regions are
+    person-sized: at least ``settings.max_second_region_ratio`` of its area, itself
+    included)."""
+    largest = int(np.argmax(areas))
+    return largest, int(np.sum(areas >= settings.max_second_region_ratio * areas[largest]))
+
+
 def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray:
     """The largest region of ``mask``; UserError if it is no person, not alone or cut by the frame."""
     height, width = mask.shape
@@ -293,8 +301,7 @@ def _person_region(mask: np.ndarray, settings: SilhouetteSettings) -> np.ndarray
             f"{settings.min_person_fraction:.1%} of the image; stand the person in front of the backdrop, "
             "in clothes that do not match its colour"
         )
-    largest = int(np.argmax(areas))
-    similar = int(np.sum(areas >= settings.max_second_region_ratio * areas[largest]))
+    largest, similar = _largest_region(areas, settings)
     if similar > 1:
         raise _NotSurrounded(
             f"{similar} person-sized regions differ from the backdrop; photograph one person at a time, "
@@ -647,9 +654,7 @@ def load_mask(path: str | Path, settings: SilhouetteSettings = SilhouetteSetting
             f"{path}: the mask is all {'white' if mask.all() else 'black'}; the person must be white on black"
         )
     labels, stats = _components(mask)
-    areas = stats[:, cv2.CC_STAT_AREA]
-    largest = int(np.argmax(areas))
-    similar = int(np.sum(areas >= settings.max_second_region_ratio * areas[largest]))
+    largest, similar = _largest_region(stats[:, cv2.CC_STAT_AREA], settings)
     if similar > 1:
         raise UserError(f"{path}: the mask holds {similar} person-sized regions; give a mask "
                         "of one person")

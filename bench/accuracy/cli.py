@@ -75,6 +75,7 @@ from bench.accuracy.scores import KEYS, RunScores
 from bench.accuracy.subject_set import (BOARD, CAMERA_FILE, SQUARE_MM, SetSettings, read_bodies,
                                         read_settings, subject_ids, write_bodies,
                                         write_photos_of_set)
+from bench.subjects import bodyfit_command
 from bodyfit.calib.images import write_image
 from bodyfit.calib.segmenters import SEGMENTERS
 from bodyfit.calib.silhouette import photo_silhouette
@@ -126,14 +127,6 @@ def make(args) -> None:
 
 
 
-def _command(name: str) -> str:
-    """The bodyfit command ``name`` of this Python's environment (found even when the
-    environment is not activated), else the one on PATH."""
-    beside = Path(sys.executable).parent / name
-    return str(beside) if beside.exists() else name
-
-
-
 def _table_rows(folder: Path, first: int | None, skip: int = 0) -> list[str]:
     """subjects.csv's header and its rows ``skip`` to ``first`` - 1 (to the last without
     ``first``): as many women as men when both are even (subject_set's order)."""
@@ -167,7 +160,7 @@ def fit(args, batch_options: list[str]) -> None:
     camera = folder / CAMERA_FILE
     if args.camera == "calibrated" and not camera.exists():
         photos = sorted(str(p) for p in (folder / "board").glob("*.png"))
-        subprocess.run([_command("calib"), "capture", *photos, "--board", BOARD, "--square-mm",
+        subprocess.run([bodyfit_command("calib"), "capture", *photos, "--board", BOARD, "--square-mm",
                         f"{SQUARE_MM:g}", "-o", str(camera)], check=True,
                        stdout=subprocess.DEVNULL)
     out = folder / "runs" / args.name
@@ -185,7 +178,7 @@ def fit(args, batch_options: list[str]) -> None:
         table.write_text("".join(row + "\n" for row in rows))
     # a set with uncalibrated subjects names each subject's camera in its table
     per_row = read_settings(folder).per_row_camera
-    command = [_command("fitter"), "-q", "batch", str(table), "-o", str(out),
+    command = [bodyfit_command("fitter"), "-q", "batch", str(table), "-o", str(out),
                *(["--camera", str(camera)] if args.camera == "calibrated" and not per_row
                  else []),
                *batch_options]

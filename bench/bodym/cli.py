@@ -36,11 +36,14 @@ import cv2
 import numpy as np
 from scipy import stats
 
+from bench.accuracy.runs import FITTED
+from bench.accuracy.scores import error_stats
 from bench.bodym.dataset import (DEFAULT_SPLIT, PARTS, SHARED_KEYS, Subject, part,
                                  read_split)
 from bench.bodym.scores import (PAPER_TABLE2, PhotoFits, bmi_band_errors,
                                 height_weight_predictions, measurement_stats, offsets,
                                 precision_sd)
+from bench.subjects import bodyfit_command
 from bodyfit.fitter.batch.tables import FAILURES_FILE, SUMMARY_FILE, csv_text, read_table
 from bodyfit.fitter.measure.measurements import MEASUREMENTS
 
@@ -89,9 +92,7 @@ def fit(args, batch_options: list[str]) -> None:
     out.mkdir(parents=True, exist_ok=True)
     table = out / "subjects.csv"
     table.write_text(csv_text(header, rows))
-    python_bin = Path(sys.executable).parent
-    fitter = str(python_bin / "fitter") if (python_bin / "fitter").exists() else "fitter"
-    command = [fitter, "-q", "batch", str(table), "-o", str(out), "--projection",
+    command = [bodyfit_command("fitter"), "-q", "batch", str(table), "-o", str(out), "--projection",
                "orthographic", "--no-check", *batch_options]
     code = subprocess.run(command).returncode
     if code not in (0, 1):  # 1: some subjects failed (recorded in failures.csv)
@@ -109,7 +110,7 @@ def read_fits(name: str, subjects: list[Subject]) -> PhotoFits:
     names = [MEASUREMENTS[k][0] for k in SHARED_KEYS]
     fitted, estimates, spreads, costs = [], [], [], []
     for row in read_table(out / SUMMARY_FILE, ("id",)):
-        if row["id"] in by_photo and row["status"] in ("fitted", "fitted earlier"):
+        if row["id"] in by_photo and row["status"] in FITTED:
             fitted.append(row["id"])
             estimates.append([float(row[f"{n}_mm"]) for n in names])
             spreads.append([float(row[f"{n}_spread_mm"]) for n in names])
@@ -174,12 +175,12 @@ def _paired(fits: PhotoFits, other: PhotoFits, removed: np.ndarray,
         ("chest, waist, hip", _CHEST_WAIST_HIP), ("all 13", SHARED_KEYS)]
     lines += [_row(["measurement", "this run", "the other", "difference"]),
               _row(["---", "---:", "---:", "---:"])]
-    t = stats.t.ppf(0.975, max(len(shared) - 1, 1)) / np.sqrt(max(len(shared), 1))
-    for label, keys in groups:
-        cols = [SHARED_KEYS.index(k) for k in keys]
-        diff = err_a[:, cols].mean(1) - err_b[:, cols].mean(1)
+    columns = [[SHARED_KEYS.index(k) for k in keys] for _, keys in groups]
+    change = error_stats(np.stack([err_a[:, c].mean(1) - err_b[:, c].mean(1)
+                                   for c in columns], axis=1))
+    for (label, _), cols, mean, half in zip(groups, columns, change.bias, change.bias_ci):
         lines.append(_row([label, f"{err_a[:, cols].mean():.1f}", f"{err_b[:, cols].mean():.1f}",
-                           f"{diff.mean():+.1f} (±{t * diff.std(ddof=1):.1f})"]))
+                           f"{mean:+.1f} (±{half:.1f})"]))
     return lines
 
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy import stats
 
+from bench.accuracy.scores import error_stats
 from bench.bodym.dataset import SHARED_KEYS, Subject
 
 __all__ = ["PAPER_TABLE2", "BMI_BANDS", "PhotoFits", "MeasurementStats", "measurement_stats",
@@ -98,16 +98,12 @@ def measurement_stats(errors: np.ndarray, spreads: np.ndarray,
     """:class:`MeasurementStats` of ``errors`` and ``spreads`` (N, 13) mm, N >= 2, with
     ``removed_offsets`` (13,) mm subtracted for ``mae_after``."""
     errors = np.asarray(errors, float)
-    n = len(errors)
-    if n < 2:
-        raise ValueError(f"statistics need at least 2 people, got {n}")
+    raw = error_stats(errors, spreads)  # the accuracy benchmark's: mean, bias, intervals
     absolute = np.abs(errors)
-    t = stats.t.ppf(0.975, n - 1) / np.sqrt(n)
     after = np.abs(errors - removed_offsets)
-    return MeasurementStats(n, absolute.mean(0), np.median(absolute, 0), errors.mean(0),
-                            t * errors.std(0, ddof=1), (absolute > 50).mean(0),
-                            (absolute > 100).mean(0), (absolute <= spreads).mean(0),
-                            after.mean(0), (after <= spreads).mean(0))
+    return MeasurementStats(raw.count, raw.mae, np.median(absolute, 0), raw.bias,
+                            raw.bias_ci, (absolute > 50).mean(0), (absolute > 100).mean(0),
+                            raw.covered, after.mean(0), (after <= spreads).mean(0))
 
 
 def offsets(choice_fits: PhotoFits) -> np.ndarray:

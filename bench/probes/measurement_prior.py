@@ -17,9 +17,9 @@ from __future__ import annotations
 import argparse
 
 import numpy as np
-from scipy import stats
 
 from bench.accuracy.runs import FITTED, read_truths, subject_row
+from bench.accuracy.scores import error_stats
 from bodyfit.fitter.batch.tables import read_table
 from bodyfit.fitter.fit.measurement_prior import MeasurementPrior, combined
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
@@ -57,11 +57,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--first", type=int, help="only the set's rows before this")
     args = parser.parse_args(argv)
     without, with_prior = prior_effect(args.kept, args.truths, args.first)
-    change = with_prior - without
-    half = stats.t.ppf(0.975, len(change) - 1) * change.std(ddof=1) / np.sqrt(len(change))
-    print(f"{args.kept}: {len(change)} subjects, the 7 important measurements "
+    change = error_stats((with_prior - without)[:, None])
+    print(f"{args.kept}: {change.count} subjects, the 7 important measurements "
           f"{without.mean():.2f} -> {with_prior.mean():.2f} mm with the prior, "
-          f"{change.mean():+.3f} ± {half:.3f} paired")
+          f"{change.bias[0]:+.3f} ± {change.bias_ci[0]:.3f} paired")
 
 
 if __name__ == "__main__":

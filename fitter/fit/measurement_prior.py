@@ -52,7 +52,7 @@ class MeasurementPrior:
         """(mean (k,), SD (k,)) of ``PRIOR_KEYS`` for ``sex`` given ``given`` (key ->
         value: "O" mm, "mass_kg" kg), and the log-density of ``given`` under the sex."""
         st = self.stats
-        cov = st.correlation[sex] * np.outer(st.std[sex], st.std[sex])
+        cov = st.covariance(sex)
         known = [st.keys.index(k) for k in given]
         wanted = [st.keys.index(k) for k in PRIOR_KEYS]
         values = np.array(list(given.values()), float)

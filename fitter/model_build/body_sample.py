@@ -95,6 +95,10 @@ class ReferenceStats:
                               {s: c[np.ix_(idx, idx)] for s, c in self.correlation.items()},
                               dict(self.n))
 
+    def covariance(self, sex: str) -> np.ndarray:
+        """(k, k) float64: the covariance of ``sex``'s columns, mm^2 (kg^2 for a mass)."""
+        return self.correlation[sex] * np.outer(self.std[sex], self.std[sex])
+
     def sample(self, sex: str, n: int, rng: np.random.Generator) -> np.ndarray:
         """(n, k) float64 mm: multivariate normal draws, z-scores clipped at +-3."""
         z = rng.multivariate_normal(np.zeros(len(self.keys)), self.correlation[sex], size=n)

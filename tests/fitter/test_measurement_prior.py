@@ -19,8 +19,8 @@ def test_the_prediction_is_the_regression_of_draws_of_ansurs_normal(prior, sex, 
     """A least-squares line of each measurement on the stature (and mass) over 400,000
     draws of the sex's normal predicts what the conditional does, with its residual SD."""
     st = prior.stats
-    cov = st.correlation[sex] * np.outer(st.std[sex], st.std[sex])
-    draws = np.random.default_rng(1).multivariate_normal(st.mean[sex], cov, 400_000)
+    draws = np.random.default_rng(1).multivariate_normal(st.mean[sex], st.covariance(sex),
+                                                         400_000)
     given = ["O", "mass_kg"] if with_mass else ["O"]
     design = np.c_[np.ones(len(draws)), draws[:, [st.keys.index(k) for k in given]]]
     targets = draws[:, [st.keys.index(k) for k in PRIOR_KEYS]]
