@@ -7,6 +7,8 @@ Run from the repository root (what they measured: docs/accuracy.md, "Real people
     # fitter batch options after -- (resumable: rerun to continue, or to fit more rows)
     python -m bench.bodym fit bodyfit --first 100
     python -m bench.bodym fit mass --first 100 --mass
+    # of the first 400, those whose side masks' feet do not tell the side, fitted as left
+    python -m bench.bodym fit untold-left --first 400 --side-untold -- --side-from left
     # every photo pair of those subjects (repeat photos: the precision)
     python -m bench.bodym fit bodyfit-all --first 100 --photos all
     # the tables: per measurement, baselines beside, paired against another run
@@ -44,7 +46,9 @@ from bench.bodym.scores import (PAPER_TABLE2, PhotoFits, bmi_band_errors,
                                 height_weight_predictions, measurement_stats, offsets,
                                 precision_sd)
 from bench.subjects import bodyfit_command
+from bodyfit.calib.silhouette import load_mask
 from bodyfit.fitter.batch.tables import FAILURES_FILE, SUMMARY_FILE, csv_text, read_table
+from bodyfit.fitter.fit.facing import side_seen
 from bodyfit.fitter.measure.measurements import MEASUREMENTS
 
 __all__ = ["main"]
@@ -80,6 +84,9 @@ def fit(args, batch_options: list[str]) -> None:
     subjects = _window(args)
     masks = RUNS / "masks"
     masks.mkdir(parents=True, exist_ok=True)
+    if args.side_untold:
+        subjects = [s for s in subjects if side_seen(load_mask(
+            str(_padded_masks(s.photo_ids[0], split, masks)[1]))) is None]
     header = ["id", "front", "side", "mask_front", "mask_side", "height_cm", "sex", "mass_kg"]
     rows = []
     for s in subjects:
@@ -255,6 +262,10 @@ def parse(argv: list[str]) -> tuple[argparse.Namespace, list[str]]:
                             help="the stature given: the stated height, or the scan's")
     fit_parser.add_argument("--mass", action="store_true",
                             help="give each person's stated weight as the mass (mass_kg)")
+    fit_parser.add_argument("--side-untold", action="store_true",
+                            help="only the subjects whose first side mask's feet do not "
+                                 "tell which side it shows (whom --side-from auto fits "
+                                 "both ways)")
     rep = sub.choices["report"]
     rep.add_argument("--offsets-from", metavar="RUN",
                      help="a choice-part run whose mean signed errors are the offsets "

@@ -86,8 +86,8 @@ def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object
                 out_dir: Path) -> SubjectJob:
     """The job of one row: the row's inputs (its camera, background plates and sex, else
     the batch's ``options["camera"]``, ``options["background_front"]`` and
-    ``["background_side"]``, and ``options["sex"]``; the batch's segmenter and photography
-    check) and
+    ``["background_side"]``, and ``options["sex"]``; the batch's segmenter, photography
+    check and ``--side-from``) and
     ``base`` with the batch's fit options (:func:`~bodyfit.fitter.run.options.fit_settings`),
     the row's weights replacing ``--weights`` (``--weight`` overrides still apply).
 
@@ -109,6 +109,7 @@ def subject_job(row: SubjectRow, base: FitSettings, options: Mapping[str, object
         background_side=given.background_side or options.get("background_side"),
         segmenter=options.get("segmenter") or "auto",
         check=options.get("check") is not False,
+        side_from=options.get("side_from") or "auto",
         sex=given.sex if given.sex != "unknown" else options.get("sex") or "unknown")
     if row.weights is not None:
         options = {**options, "weights": row.weights}

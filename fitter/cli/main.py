@@ -17,6 +17,7 @@ from bodyfit.calib.segmenters import SEGMENTER_HELP, SEGMENTERS
 from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
+from bodyfit.fitter.fit.facing import SIDE_FROM, side_text
 from bodyfit.fitter.fit.pitch import PITCHES, pitch_text
 
 __all__ = ["main"]
@@ -89,6 +90,11 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                         help="the person's sex, read by the learned start (default "
                              "unknown)"
                              + ("; for the rows without a sex" if batch else ""))
+    parser.add_argument("--side-from", choices=SIDE_FROM,
+                        help="which side of the person the side photo shows (left: the "
+                             "person faces the image's left); auto (default): told by the "
+                             "feet, and where they do not tell, both fitted and the lower "
+                             "cost kept" + ("; for every row" if batch else ""))
     parser.add_argument("--weights", metavar="PRESET|FILE.toml",
                         help="cost weights: bodyfit (Table 2 without the top and bottom "
                              "terms, the head and neck 4; the default), paper (Table 2; "
@@ -436,8 +442,8 @@ def _cmd_demo(args) -> None:
 def _photos_line(fit) -> str:
     """What was read of the photos besides the silhouettes, for the summary."""
     pitch = fit.photos.get("pitch_deg")
-    return (f"  camera: {fit.photos['camera']}; the side photo shows the person's "
-            f"{fit.photos['side_from']} side"
+    return (f"  camera: {fit.photos['camera']}; the side photo shows "
+            f"{side_text(fit.photos)}"
             + (f"; the cameras' pitch: {pitch_text(pitch)}" if pitch else ""))
 
 

@@ -19,10 +19,14 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["FACING_MARGIN", "SIDES", "facing_reach", "side_seen"]
+__all__ = ["FACING_MARGIN", "SIDES", "SIDE_FROM", "facing_reach", "side_seen", "side_text"]
 
 #: Which side of the person a side photo shows: "left" faces the image's left.
 SIDES = ("left", "right")
+#: ``--side-from``: a side of :data:`SIDES`, or "auto": told by the feet
+#: (:func:`side_seen`), and where they do not tell, the fit tries both
+#: (:func:`bodyfit.fitter.fit.person_fit.fit_inputs`).
+SIDE_FROM = ("auto", *SIDES)
 _FEET_BAND = (0.0, 0.05)  # rows above the lowest person row, fraction of the height
 _SHIN_BAND = (0.12, 0.2)
 #: The toes must reach this much further (fraction of the height) one way than the
@@ -60,3 +64,16 @@ def side_seen(mask: np.ndarray) -> str | None:
     if abs(reach) < FACING_MARGIN:
         return None
     return "left" if reach > 0 else "right"
+
+
+def side_text(photos: dict) -> str:
+    """Which side of the person the side photo shows, in words, for the summary and the
+    report, from a fit's ``photos`` record (``side_from``, and ``side_costs`` where the
+    fit tried both sides)."""
+    text = f"the person's {photos['side_from']} side"
+    costs = photos.get("side_costs")
+    if costs:
+        other = next(side for side in costs if side != photos["side_from"])
+        text += (f" (the feet do not tell; fitted both ways, its cost "
+                 f"{costs[photos['side_from']]:.1f} against {costs[other]:.1f})")
+    return text

@@ -6,8 +6,8 @@ turned upright by EXIF (:func:`bodyfit.calib.silhouette.photo_silhouette`). A us
 mask replaces the extraction; it must be of the undistorted, upright photo.
 
 The side photo may show either side of the person: one taken from the person's right
-(told by :func:`bodyfit.fitter.fit.facing.side_seen`) is mirrored, mask and camera, into
-the photo from the left the fit expects. The camera: camera.json when given; else the
+(given, or told by :func:`bodyfit.fitter.fit.facing.side_seen`) is mirrored, mask and
+camera, into the photo from the left the fit expects (:func:`mirrored_side`). The camera: camera.json when given; else the
 focal length the photos' EXIF states; else a typical phone's (:class:`PersonPhotos`
 records which).
 """
@@ -26,12 +26,13 @@ from bodyfit.calib.undistort import undistort_image
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
 from bodyfit.fitter.check.photos import PhotoCheckFailed, ViewVerdict, check_view, failed_lines
-from bodyfit.fitter.fit.facing import side_seen
+from bodyfit.fitter.fit.facing import SIDE_FROM, side_seen
 from bodyfit.fitter.fit.pinhole_canvas import (PHONE_HFOV_DEG, phone_intrinsics,
                                                upright_intrinsics)
 
-__all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "MASS_RANGE_KG", "checked_photos",
-           "person_masks", "upright_photo", "view_intrinsics", "person_silhouettes"]
+__all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "MASS_RANGE_KG",
+           "checked_photos", "mirrored_side", "person_masks", "upright_photo",
+           "view_intrinsics", "person_silhouettes"]
 
 #: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
 #: most likely given in other units).
@@ -71,6 +72,8 @@ class PersonInputs:
             the fit (``--no-check``: False).
         mass_kg: the body's mass, kilograms, or None (read by the measurements' prior,
             :mod:`bodyfit.fitter.fit.measurement_prior`).
+        side_from: which side of the person the side photo shows, one of
+            :data:`~bodyfit.fitter.fit.facing.SIDE_FROM`.
     """
 
     front: str
@@ -85,6 +88,7 @@ class PersonInputs:
     segmenter: str = "auto"
     check: bool = True
     mass_kg: float | None = None
+    side_from: str = "auto"
 
     def validate(self) -> None:
         lo, hi = STATURE_RANGE_CM
@@ -97,6 +101,9 @@ class PersonInputs:
                             f"got {self.mass_kg:g}")
         if self.sex not in SEXES:
             raise UserError(f"--sex must be one of {', '.join(SEXES)}, got {self.sex!r}")
+        if self.side_from not in SIDE_FROM:
+            raise UserError(f"--side-from must be one of {', '.join(SIDE_FROM)}, "
+                            f"got {self.side_from!r}")
         self.validate_photos()
 
     def validate_photos(self) -> None:
@@ -244,8 +251,9 @@ class PersonPhotos:
             the person's left (mirrored when the photo shows the right).
         intrinsics: view name -> (3, 3) K of those masks (None: orthographic views).
         camera_source: where K came from (:func:`view_intrinsics`; "" orthographic).
-        side_from: which side of the person the side photo shows: "left", "right", or
-            "left (assumed)" when the feet do not tell.
+        side_from: which side of the person the side photo shows: "left" or "right" as
+            given or told by the feet; "unknown" when the feet do not tell (the fit tries
+            both).
         check: the photography check's warnings, one line each; None where it was not run.
         images: view name -> (H, W, 3) uint8 BGR, the photos undistorted and upright
             (:func:`upright_photo`), as taken (the side one not mirrored).
@@ -284,11 +292,20 @@ def person_silhouettes(inputs: PersonInputs, projection: str) -> PersonPhotos:
         warnings = tuple(line for verdict in verdicts for line in verdict.warnings)
     intrinsics, source = (view_intrinsics(inputs, masks) if projection == "pinhole"
                           else (None, ""))
-    seen = side_seen(masks["side"])
-    if seen == "right":
-        masks = masks | {"side": np.ascontiguousarray(masks["side"][:, ::-1])}
-        if intrinsics is not None:
-            mirrored = intrinsics["side"].copy()
-            mirrored[0, 2] = masks["side"].shape[1] - 1 - mirrored[0, 2]
-            intrinsics = intrinsics | {"side": mirrored}
-    return PersonPhotos(masks, intrinsics, source, seen or "left (assumed)", warnings, images)
+    seen = (inputs.side_from if inputs.side_from != "auto" else side_seen(masks["side"])
+            or "unknown")
+    photos = PersonPhotos(masks, intrinsics, source, seen, warnings, images)
+    return mirrored_side(photos) if seen == "right" else photos
+
+
+def mirrored_side(photos: PersonPhotos) -> PersonPhotos:
+    """``photos`` with the side mask and its camera mirrored left to right: a side photo
+    from the person's right seen as the one from the left the fit expects (the model's
+    bodies are left-right symmetric)."""
+    masks = photos.masks | {"side": np.ascontiguousarray(photos.masks["side"][:, ::-1])}
+    intrinsics = photos.intrinsics
+    if intrinsics is not None:
+        mirrored = intrinsics["side"].copy()
+        mirrored[0, 2] = masks["side"].shape[1] - 1 - mirrored[0, 2]
+        intrinsics = intrinsics | {"side": mirrored}
+    return dataclasses.replace(photos, masks=masks, intrinsics=intrinsics)

@@ -21,7 +21,7 @@ from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
 from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
 from bodyfit.fitter.fit.measurement_prior import PRIORS, MeasurementPrior, combined
-from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes
+from bodyfit.fitter.fit.person import PersonInputs, mirrored_side, person_silhouettes
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
 from bodyfit.fitter.fit.pinhole_canvas import pinhole_view, placed_anew, view_pitch_deg
 from bodyfit.fitter.fit.pitch import PITCH_ITERATIONS, searched_pitches
@@ -193,7 +193,8 @@ class Fit:
             view's arms down; not rescaled to the stature): what the view's canvas shows.
         photos: what was read of the photos besides their masks (:func:`fit_inputs`):
             ``camera`` (where K came from), ``side_from`` (which side the side photo
-            shows), where the photography check ran ``check_warnings`` (its warnings,
+            shows), ``side_costs`` where the fit tried both sides (each one's answer
+            cost), where the photography check ran ``check_warnings`` (its warnings,
             one line each), and ``fit_warning`` for a fit that matched its silhouettes
             poorly (:func:`~bodyfit.fitter.fit.spreads.match_warning`); empty for a fit
             of masks.
@@ -698,14 +699,34 @@ def fit_inputs(model: BodyModel, inputs: PersonInputs, settings: FitSettings = F
     photos' intrinsics; ``Fit.photos`` says what was read (and, through a pinhole camera,
     ``pitch_deg``: each camera's pitch as fitted, degrees).
 
+    Where neither the user nor the feet tell which side the side photo shows, the person
+    is fitted both ways and the fit with the lower answer cost kept; ``Fit.photos``
+    then holds ``side_costs``, each way's answer cost, and ``Fit.seconds`` both fits'.
+
     Raises:
         UserError: the inputs' problems
             (:func:`~bodyfit.fitter.fit.person.person_silhouettes`).
     """
     photos = person_silhouettes(inputs, settings.projection)
-    fit = fit_person(model, photos.masks, inputs.height_cm / 100.0, settings, progress,
-                     photos.intrinsics, inputs.sex, inputs.mass_kg)
-    read = {"camera": photos.camera_source or "orthographic", "side_from": photos.side_from}
+
+    def fitted(photos):
+        return fit_person(model, photos.masks, inputs.height_cm / 100.0, settings, progress,
+                          photos.intrinsics, inputs.sex, inputs.mass_kg)
+
+    read = {}
+    if photos.side_from == "unknown":
+        ways = {"left": photos, "right": mirrored_side(photos)}
+        fits = {side: fitted(way) for side, way in ways.items()}
+        costs = {side: answer_cost(f.search) for side, f in fits.items()}
+        side = min(costs, key=costs.get)
+        photos = dataclasses.replace(ways[side], side_from=side)
+        fit = dataclasses.replace(fits[side], seconds={
+            stage: sum(f.seconds[stage] for f in fits.values()) for stage in fits[side].seconds})
+        read["side_costs"] = {side: round(cost, 2) for side, cost in costs.items()}
+    else:
+        fit = fitted(photos)
+    read = {"camera": photos.camera_source or "orthographic", "side_from": photos.side_from,
+            **read}
     if photos.check is not None:
         read["check_warnings"] = list(photos.check)
     poor = match_warning(answer_cost(fit.search), fit.spread_basis)

@@ -13,6 +13,7 @@ import html
 import numpy as np
 
 from bodyfit.calib.images import encode_image
+from bodyfit.fitter.fit.facing import side_text
 from bodyfit.fitter.fit.pitch import pitch_text
 from bodyfit.fitter.fit.spreads import SPREAD_NOTES
 from bodyfit.fitter.measure.measurements import IMPORTANT, MEASUREMENTS
@@ -148,7 +149,7 @@ def report_html(record: dict, values: dict[str, float], spreads: dict[str, float
     if "camera" in photos:
         given.append(("camera used", _e(photos["camera"])))
     if "side_from" in photos:
-        given.append(("side photo", f"the person's {_e(photos['side_from'])} side"))
+        given.append(("side photo", _e(side_text(photos))))
     if "pitch_deg" in photos:
         given.append(("cameras' pitch", pitch_text(photos["pitch_deg"])))
     if "check_warnings" in photos:

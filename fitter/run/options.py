@@ -24,7 +24,7 @@ __all__ = ["INPUT_OPTIONS", "SEARCH_OPTIONS", "base_settings", "fit_settings"]
 #: `fitter run`'s options that are fields of PersonInputs, and of SearchSettings.
 INPUT_OPTIONS = ("front", "side", "height_cm", "camera", "mask_front", "mask_side",
                  "background_front", "background_side", "sex", "segmenter", "check",
-                 "mass_kg")
+                 "mass_kg", "side_from")
 SEARCH_OPTIONS = ("optimizer", "population", "generations", "components", "seed",
                   "searches", "refine_components", "refine_generations", "refinements")
 

@@ -1,6 +1,7 @@
 """What a fit reads of the photos besides their silhouettes: which side the side photo
 shows (a photo from the right fitted as its mirror image), and EXIF's focal length."""
 
+import dataclasses
 import math
 
 import cv2
@@ -9,8 +10,10 @@ import pytest
 from PIL import ExifTags, Image
 
 from bodyfit.calib.images import FULL_FRAME_DIAGONAL_MM, read_photo
+from bodyfit.common.errors import UserError
 from bodyfit.fitter.demo.studio_photos import pinhole_photo, write_pinhole_subject
-from bodyfit.fitter.fit.facing import FACING_MARGIN, facing_reach, side_seen
+from bodyfit.fitter.fit.facing import FACING_MARGIN, facing_reach, side_seen, side_text
+from bodyfit.fitter.fit import person
 from bodyfit.fitter.fit.person import PersonInputs, person_silhouettes, view_intrinsics
 from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
 from bodyfit.fitter.fit.side_arms import side_photo_pose
@@ -58,7 +61,8 @@ def test_side_seen_from_the_feet_of_a_drawn_profile():
     assert abs(facing_reach(mask)) < FACING_MARGIN and side_seen(mask) is None
 
 
-def test_side_photo_from_the_right_is_fitted_as_its_mirror_image(body_model, subject):
+def test_side_photo_from_the_right_is_fitted_as_its_mirror_image(body_model, subject,
+                                                                 monkeypatch):
     folder, truth = subject
     fits = {name: fit_inputs(body_model, _inputs(folder, truth, f"{name}.png"), FitSettings(),
                              progress=False)
@@ -74,6 +78,32 @@ def test_side_photo_from_the_right_is_fitted_as_its_mirror_image(body_model, sub
     gap = np.mean([abs(fits["right"].measurements[k] - fits["side"].measurements[k])
                    for k in IMPORTANT])
     assert gap < 1.5
+    # feet that do not tell: both ways fitted, the photo from the right's lower cost kept,
+    # and that fit is the one told by the feet
+    monkeypatch.setattr(person, "side_seen", lambda mask: None)
+    untold = fit_inputs(body_model, _inputs(folder, truth, "right.png"), FitSettings(),
+                        progress=False)
+    costs = untold.photos["side_costs"]
+    assert untold.photos["side_from"] == "right" and costs["right"] < costs["left"] - 5
+    assert untold.measurements == fits["right"].measurements
+    assert untold.seconds["search"] > fits["right"].seconds["search"]
+    assert side_text(untold.photos) == (
+        f"the person's right side (the feet do not tell; fitted both ways, its cost "
+        f"{costs['right']:.1f} against {costs['left']:.1f})")
+
+
+def test_side_from_given_overrides_the_feet(subject):
+    folder, truth = subject
+    told = person_silhouettes(_inputs(folder, truth), "pinhole")
+    given = person_silhouettes(dataclasses.replace(_inputs(folder, truth), side_from="right"),
+                               "pinhole")
+    assert told.side_from == "left" and given.side_from == "right"
+    np.testing.assert_array_equal(given.masks["side"], told.masks["side"][:, ::-1])
+    cx = told.intrinsics["side"][0, 2]
+    assert given.intrinsics["side"][0, 2] == pytest.approx(SIZE[0] - 1 - cx)
+    with pytest.raises(UserError, match="--side-from must be one of auto, left, right"):
+        person_silhouettes(dataclasses.replace(_inputs(folder, truth), side_from="front"),
+                           "pinhole")
 
 
 def _with_focal_exif(source, target, full_frame_mm: int):

@@ -15,6 +15,7 @@ from bodyfit.common.errors import UserError
 from bodyfit.fitter.cli.main import main
 from bodyfit.fitter.demo.studio_photos import write_subject
 from bodyfit.fitter.fit import person_fit as fit_module
+from bodyfit.fitter.fit.facing import side_text
 from bodyfit.fitter.fit.local_solver import SolverSettings
 from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import FitSettings
@@ -120,7 +121,7 @@ def test_report_is_one_self_contained_escaped_page(first_run):
     assert "<th>optimizer</th><td>ga</td>" in text and "<th>seed</th><td>5</td>" in text
     photos = json.loads((first_run / "run.json").read_text())["photos"]
     assert f"<th>camera used</th><td>{html.escape(photos['camera'])}</td>" in text
-    assert f"<th>side photo</th><td>the person's {photos['side_from']} side</td>" in text
+    assert f"<th>side photo</th><td>{html.escape(side_text(photos))}</td>" in text
 
 
 def test_run_json_round_trips_into_the_same_settings(first_run):
