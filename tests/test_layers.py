@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: The fitter's sub-packages, lowest first: each may import those before it, not after.
 FITTER_LAYERS = ("model", "measure", "model_build", "check", "fit", "output", "training", "run",
-                 "batch", "demo", "cli")
+                 "batch", "serve", "demo", "cli")
 
 #: The other top-level packages -> the bodyfit packages they may import.
 ALLOWED = {

@@ -1,7 +1,7 @@
-"""Draw docs/poses.png: the two poses to photograph, cut from a demo's photos.
+"""Draw fitter/data/poses.png: the two poses to photograph, cut from a demo's photos.
 
     fitter demo -o out/demo
-    python tools/poses_picture.py out/demo -o docs/poses.png
+    python tools/poses_picture.py out/demo -o fitter/data/poses.png
 
 Finds the person in DIR/front.png and DIR/side.png (the pixels whose colour differs from
 the backdrop's, the median of the photo's border), cuts a panel around each, scaled so
@@ -48,7 +48,7 @@ def panel(photo: np.ndarray, label: str, height_px: int, width_px: int,
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("demo_dir", type=Path, help="a fitter demo folder (front.png, side.png)")
-    parser.add_argument("-o", "--output", type=Path, default=Path("docs/poses.png"))
+    parser.add_argument("-o", "--output", type=Path, default=Path("fitter/data/poses.png"))
     parser.add_argument("--height-px", type=int, default=300, help="each person's height, pixels")
     args = parser.parse_args()
     panels = []

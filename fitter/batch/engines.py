@@ -33,7 +33,8 @@ from bodyfit.common.errors import UserError
 from bodyfit.common.files import file_sha256
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome, run_subject
 
-__all__ = ["WorkerSetup", "WorkerDeaths", "LocalEngine", "start_worker"]
+__all__ = ["WorkerSetup", "WorkerDeaths", "LocalEngine", "local_pool", "run_local_job",
+           "start_worker"]
 
 logger = logging.getLogger(__name__)
 
@@ -146,12 +147,22 @@ def _init_local_worker(setup: WorkerSetup, counter, parent_pid: int) -> None:
     _worker_model = start_worker(setup)
 
 
-def _run_local_job(job: SubjectJob) -> SubjectOutcome:
+def run_local_job(job: SubjectJob) -> SubjectOutcome:
+    """Run ``job`` in a worker of :func:`local_pool`."""
     return run_subject(job, _worker_model, _worker_device, _worker_threads)
 
 
 def _local_worker_ready() -> int:
     return os.getpid()
+
+
+def local_pool(workers: int, setup: WorkerSetup) -> ProcessPoolExecutor:
+    """``workers`` worker processes, started with "spawn", each with the body model loaded
+    (:func:`start_worker`): submit :func:`run_local_job` to them."""
+    context = multiprocessing.get_context("spawn")
+    counter = context.Value("i", 0) if setup.devices else None
+    return ProcessPoolExecutor(workers, context, initializer=_init_local_worker,
+                               initargs=(setup, counter, os.getpid()))
 
 
 class LocalEngine:
@@ -163,12 +174,6 @@ class LocalEngine:
         if workers < 1:
             raise UserError(f"--workers must be at least 1, got {workers}")
         self.workers, self.setup = workers, setup
-        self._context = multiprocessing.get_context("spawn")
-
-    def _pool(self) -> ProcessPoolExecutor:
-        counter = self._context.Value("i", 0) if self.setup.devices else None
-        return ProcessPoolExecutor(self.workers, self._context, initializer=_init_local_worker,
-                                   initargs=(self.setup, counter, os.getpid()))
 
     def run(self, jobs: Iterable[SubjectJob], report: Callable[[SubjectOutcome], None]) -> None:
         """Run every job, calling ``report`` with each outcome as it comes (in the order
@@ -182,7 +187,7 @@ class LocalEngine:
 
     def _run(self, queue, deaths: WorkerDeaths, report) -> None:
         while queue:
-            pool = self._pool()
+            pool = local_pool(self.workers, self.setup)
             try:
                 try:
                     pool.submit(_local_worker_ready).result()
@@ -209,7 +214,7 @@ class LocalEngine:
                     break  # a suspect runs alone
                 job = queue.popleft()
                 try:
-                    in_flight[pool.submit(_run_local_job, job)] = job
+                    in_flight[pool.submit(run_local_job, job)] = job
                 except BrokenProcessPool:  # a worker died since the last wait: the job
                     queue.appendleft(job)  # waits, the futures in flight say who died
                     broken = True

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 import time
 from pathlib import Path
@@ -311,6 +312,22 @@ def _build_parser() -> argparse.ArgumentParser:
     batch.add_argument("--skip-bad-rows", action="store_true",
                        help="skip the table's bad rows, each reported, instead of stopping")
     _add_fit_options(batch, batch=True)
+
+    serve = sub.add_parser(
+        "serve", help="the studio page: photograph, check and measure people from a phone "
+                      "or this computer's browser",
+        description="A web page to measure people: their photos taken on a phone, checked "
+                    "at once, fitted on this computer; the people and their fits kept in "
+                    "DATA (docs/serve.md).")
+    serve.add_argument("--host", default="127.0.0.1",
+                       help="the address to listen on (default 127.0.0.1: this computer "
+                            "only; 0.0.0.0: the studio's network, with an access token)")
+    serve.add_argument("--port", type=int, default=8000, help="the port (default 8000)")
+    serve.add_argument("--data", type=Path, default=Path("bodyfit-studio"), metavar="DIR",
+                       help="the folder of the people, fits and photos (default "
+                            "./bodyfit-studio; created)")
+    serve.add_argument("--workers", type=int, metavar="N",
+                       help="fits at once (default: one per CPU core)")
 
     measure = sub.add_parser("measure", help="the 16 measurements (mm) of a mesh in the "
                                              "model's topology (.obj/.ply)")
@@ -668,6 +685,59 @@ def _cmd_measure(args) -> None:
         print(f"wrote {args.output} and {csv_path}")
 
 
+def _lan_address() -> str:
+    """This computer's address on its network (where a phone reaches it), or 127.0.0.1."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+        try:
+            probe.connect(("10.255.255.255", 1))  # sends nothing: picks the route's address
+            return probe.getsockname()[0]
+        except OSError:
+            return "127.0.0.1"
+
+
+def _cmd_serve(args) -> int:
+    import secrets
+    import socket
+
+    import uvicorn
+
+    from bodyfit.common.files import check_writable_dir, file_sha256
+    from bodyfit.fitter.batch.engines import WorkerSetup
+    from bodyfit.fitter.model.cache import active_model_path
+    from bodyfit.fitter.serve.app import create_app
+
+    workers = args.workers or os.cpu_count() or 1
+    if workers < 1:
+        raise UserError(f"--workers must be at least 1, got {workers}")
+    if not 1 <= args.port <= 65535:
+        raise UserError(f"--port must be 1-65535, got {args.port}")
+    check_writable_dir(args.data)
+    try:
+        args.data.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise UserError(f"--data {args.data}: cannot create it ({error.strerror}); choose "
+                        "another folder") from None
+    with socket.socket(socket.AF_INET6 if ":" in args.host else socket.AF_INET) as probe:
+        try:
+            probe.bind((args.host, args.port))
+        except OSError as error:
+            raise UserError(f"cannot listen on {args.host} port {args.port} ({error.strerror}):"
+                            " is another fitter serve running? Choose another --port") from None
+    local = args.host in ("127.0.0.1", "localhost", "::1")
+    token = None if local else secrets.token_urlsafe(16)
+    shown = args.host if local or args.host not in ("0.0.0.0", "::") else _lan_address()
+    url = f"http://{shown}:{args.port}/" + ("" if token is None else f"?token={token}")
+    app = create_app(args.data.resolve(), WorkerSetup(file_sha256(active_model_path())),
+                     workers, token, None if token is None else url)
+    print(f"bodyfit studio: {url}" + ("" if token is None else
+                                      "  (the access link: give it only to the studio)"))
+    print(f"  data: {args.data.resolve()}; {workers} fit(s) at once; Ctrl+C stops")
+    uvicorn.run(app, host=args.host, port=args.port, log_level="warning")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     try:
         args = _build_parser().parse_args(argv)
@@ -682,7 +752,7 @@ def main(argv: list[str] | None = None) -> int:
 
     warp.config.log_level = warp.LOG_ERROR
     command = {"batch": _cmd_batch, "check": _cmd_check, "demo": _cmd_demo,
-               "measure": _cmd_measure, "run": _cmd_run}.get(args.command)
+               "measure": _cmd_measure, "run": _cmd_run, "serve": _cmd_serve}.get(args.command)
     if args.command == "model":
         command = {"build": _cmd_model_build, "info": _cmd_model_info,
                    "train-start": _cmd_model_train_start}[args.model_command]

@@ -7,9 +7,9 @@ mask replaces the extraction; it must be of the undistorted, upright photo.
 
 The side photo may show either side of the person: one taken from the person's right
 (given, or told by :func:`bodyfit.fitter.fit.facing.side_seen`) is mirrored, mask and
-camera, into the photo from the left the fit expects (:func:`mirrored_side`). The camera: camera.json when given; else the
-focal length the photos' EXIF states; else a typical phone's (:class:`PersonPhotos`
-records which).
+camera, into the photo from the left the fit expects (:func:`mirrored_side`). The camera:
+camera.json when given; else the focal length the photos' EXIF states; else a typical
+phone's (:class:`PersonPhotos` records which).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from bodyfit.fitter.fit.pinhole_canvas import (PHONE_HFOV_DEG, phone_intrinsics,
                                                upright_intrinsics)
 
 __all__ = ["PersonInputs", "PersonPhotos", "STATURE_RANGE_CM", "MASS_RANGE_KG",
-           "checked_photos", "mirrored_side", "person_masks", "upright_photo",
+           "checked_photo", "checked_photos", "mirrored_side", "person_masks", "upright_photo",
            "view_intrinsics", "person_silhouettes"]
 
 #: Statures bodyfit accepts, centimetres (adults and teenagers; a value outside is
@@ -154,9 +154,15 @@ def _verdicts(masks: dict[str, np.ndarray], photos: dict[str, np.ndarray]
 
 
 def checked_photos(inputs: PersonInputs) -> list[ViewVerdict]:
-    """The photography check of the person's photos, front then side, on their
-    silhouettes (without :func:`person_masks`' own refusals) and :func:`upright_photo` of
-    each. Of ``inputs`` it reads the photos, masks, background plates, camera and
+    """The photography check of the person's photos, front then side
+    (:func:`checked_photo`)."""
+    return [checked_photo(inputs, view) for view in ("front", "side")]
+
+
+def checked_photo(inputs: PersonInputs, view: str) -> ViewVerdict:
+    """The photography check of the person's ``view`` photo ("front" or "side") on its
+    silhouette (without :func:`person_masks`' own refusals) and its :func:`upright_photo`.
+    Of ``inputs`` it reads that photo, mask and background plate, the camera and the
     segmenter only.
 
     Raises:
@@ -164,7 +170,10 @@ def checked_photos(inputs: PersonInputs) -> list[ViewVerdict]:
     """
     inputs.validate_photos()
     camera = _camera(inputs)
-    return _verdicts(_masks(inputs, camera), _upright_photos(inputs, camera))
+    photo = getattr(inputs, view)
+    mask = _view_mask(photo, getattr(inputs, f"mask_{view}"),
+                      getattr(inputs, f"background_{view}"), camera, inputs.segmenter)
+    return check_view(view, upright_photo(photo, camera), mask)
 
 
 def person_masks(inputs: PersonInputs) -> dict[str, np.ndarray]:
