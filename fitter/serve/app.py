@@ -20,6 +20,7 @@ import json
 import math
 import secrets
 import shutil
+import threading
 import uuid
 from pathlib import Path
 
@@ -72,6 +73,11 @@ class _Studio:
     def __init__(self, data: Path, store: Store, queue: FitQueue):
         self.data, self.store, self.queue = data, store, queue
         self.uploads: dict[str, tuple[str, Path]] = {}  # key -> (view, path)
+        self.checking = threading.Lock()  # one check at a time: the pose model is shared
+
+    def check(self, inputs: PersonInputs, view: str):
+        with self.checking:
+            return checked_photo(inputs, view)
 
 
 def _problems(lines: list[str], status: int = 400) -> JSONResponse:
@@ -118,7 +124,7 @@ async def check_photo(request: Request) -> JSONResponse:
         store_photo(await _file_bytes(form.get("photo")), path)
         # the check reads no stature
         inputs = PersonInputs(str(path), str(path), math.nan, camera)
-        verdict = await run_in_threadpool(checked_photo, inputs, view)
+        verdict = await run_in_threadpool(studio.check, inputs, view)
     except UserError as error:
         path.unlink(missing_ok=True)
         return JSONResponse({"upload": None, "problems": [str(error)], "warnings": []})
