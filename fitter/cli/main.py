@@ -168,6 +168,11 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "by its ±, so a fit that matched the silhouettes poorly leans "
                              "on them; none: the fit's own (the default before; --method "
                              "thorough's and paper's)")
+    parser.add_argument("--mass-scaling", choices=("girths", "none"),  # MASS_SCALINGS
+                        help="with --mass-kg: girths (the default) scales the "
+                             "circumferences so that the fitted body's volume at 1.0 kg/L "
+                             "is the mass, before the prior; none: the prior alone reads "
+                             "the mass (the default before; --method thorough's and paper's)")
     parser.add_argument("--refine-components", type=int, metavar="K",
                         help="after the searches, refine their answer with CMA-ES over the "
                              "first K components, --refinements of them, averaged (more "

@@ -20,6 +20,7 @@ from bodyfit.fitter.fit.canvas import (PAPER_CANVAS, CanvasSettings, extreme_bod
 from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
 from bodyfit.fitter.fit.learned_start import active_start
 from bodyfit.fitter.fit.local_solver import LocalProblem, SolverSettings, moved_view, solve
+from bodyfit.fitter.fit.mass_volume import MASS_SCALINGS, mass_scale, mass_scaled
 from bodyfit.fitter.fit.measurement_prior import PRIORS, MeasurementPrior, combined
 from bodyfit.fitter.fit.person import PersonInputs, mirrored_side, person_silhouettes
 from bodyfit.fitter.fit.photo_extents import ViewPhoto, photo_scaled_measurements
@@ -86,6 +87,10 @@ class FitSettings:
             "ansur", the measurements weighed against what ANSUR II's adults of the
             person's stature, sex (and mass) measure, each by its ± (the module
             :mod:`bodyfit.fitter.fit.measurement_prior`); "none": the fit's own.
+        mass_scaling: one of :data:`~bodyfit.fitter.fit.mass_volume.MASS_SCALINGS`:
+            with a mass given, "girths" scales the circumferences so that the fitted
+            body's volume matches it (:mod:`bodyfit.fitter.fit.mass_volume`), before the
+            prior; "none": the mass is read by the prior alone.
     """
 
     search: SearchSettings = SearchSettings(searches=0, refine_components=0,
@@ -105,6 +110,7 @@ class FitSettings:
     placement_rounds: int = 2
     photo_extents: bool = True
     measurement_prior: str = "ansur"
+    mass_scaling: str = "girths"
 
     @property
     def learned_start(self) -> bool:
@@ -150,6 +156,9 @@ class FitSettings:
         if self.measurement_prior not in PRIORS:
             raise UserError(f"--measurement-prior must be one of {', '.join(PRIORS)}, got "
                             f"{self.measurement_prior!r}")
+        if self.mass_scaling not in MASS_SCALINGS:
+            raise UserError(f"--mass-scaling must be one of {', '.join(MASS_SCALINGS)}, got "
+                            f"{self.mass_scaling!r}")
 
 
 #: The methods of ``fitter run --method``: bodyfit's default (the local solver from the
@@ -163,7 +172,7 @@ class FitSettings:
 METHODS = {
     "bodyfit": FitSettings(),
     "thorough": FitSettings(search=SearchSettings(), solver=SolverSettings(),
-                            measurement_prior="none"),
+                            measurement_prior="none", mass_scaling="none"),
     "paper": FitSettings(search=SearchSettings(optimizer="ga", population=None,
                                                generations=None, condition_stature=False,
                                                searches=1, refine_components=0),
@@ -171,7 +180,7 @@ METHODS = {
                          canvas=PAPER_CANVAS, cost=kernels.CostSettings(),
                          projection="orthographic",
                          render_cell_mm=0.0, placement_rounds=0, photo_extents=False,
-                         measurement_prior="none"),
+                         measurement_prior="none", mass_scaling="none"),
 }
 
 
@@ -201,6 +210,9 @@ class Fit:
         masks: view name -> (H, W) bool, the silhouettes of the upright photos as fitted
             (:attr:`~bodyfit.fitter.fit.person.PersonPhotos.masks`); empty for a fit of
             masks.
+        mass_scale: the scale the circumferences took from the mass
+            (:func:`~bodyfit.fitter.fit.mass_volume.mass_scale`), or None (no mass, or
+            ``mass_scaling`` "none").
         images: view name -> (H, W, 3) uint8 BGR, the photos undistorted and upright, as
             taken (:attr:`~bodyfit.fitter.fit.person.PersonPhotos.images`); empty for a
             fit of masks.
@@ -218,6 +230,7 @@ class Fit:
     photos: dict[str, object] = dataclasses.field(default_factory=dict)
     masks: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
     images: dict[str, np.ndarray] = dataclasses.field(default_factory=dict)
+    mass_scale: float | None = None
 
 
 def _view(name, mask, intrinsics, stature_m, extent, mean_body, model, settings,
@@ -633,7 +646,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
             (:func:`bodyfit.fitter.fit.person.view_intrinsics`).
         sex: "female", "male" or "unknown": read by the learned start and the
             measurements' prior.
-        mass_kg: the body's mass, kilograms, or None: read by the measurements' prior.
+        mass_kg: the body's mass, kilograms, or None: the circumferences scaled to it
+            (``settings.mass_scaling``), and read by the measurements' prior.
     """
     settings.validate(model.num_components)
     if settings.projection == "pinhole" and intrinsics is None:
@@ -664,6 +678,10 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     measurer = Measurer.from_model(model)
     measurements = fitted_measurements(model, measurer, settings, rest, view_bodies, views,
                                        masks, intrinsics)
+    scale = None
+    if mass_kg is not None and settings.mass_scaling == "girths":
+        scale = mass_scale(mass_kg, rest, model.faces)
+        measurements = mass_scaled(measurements, scale)
     calibrated = calibration_applies(settings, METHODS["bodyfit"])
     if calibrated or not s.searches:  # the solver alone has no population to measure
         spreads = bodyfit_calibration().spreads(answer_cost(result))
@@ -675,7 +693,8 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
                                                   stature_m, mass_kg)
     t3 = time.perf_counter()
     return Fit(result, posed, rest, measurements, spreads, basis, views,
-               {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies)
+               {"canvas": t1 - t0, "search": t2 - t1, "measure": t3 - t2}, view_bodies,
+               mass_scale=scale)
 
 
 def fit_work(settings: FitSettings, result: SearchResult) -> str:

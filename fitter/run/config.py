@@ -118,12 +118,16 @@ def _without_solver(settings):
 
 
 def _without_prior(settings):
-    """run.json's ``settings`` object with the measurements' prior off when it names none:
-    a run from before the prior (docs/history.md). Anything else is returned as it is, for
-    :func:`_build` to check."""
-    if not isinstance(settings, dict) or "measurement_prior" in settings:
+    """run.json's ``settings`` object with the measurements' prior and the mass scaling
+    off when it names none: a run from before them (docs/history.md). Anything else is
+    returned as it is, for :func:`_build` to check."""
+    if not isinstance(settings, dict):
         return settings
-    return {**settings, "measurement_prior": "none"}
+    if "measurement_prior" not in settings:
+        settings = {**settings, "measurement_prior": "none"}
+    if "mass_scaling" not in settings:  # a run from before it
+        settings = {**settings, "mass_scaling": "none"}
+    return settings
 
 
 def run_config(record: dict, where: str = "run.json") -> RunConfig:

@@ -55,7 +55,7 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     ``threads``, ``side_arms``, ``projection``, ``placement_rounds``, ``arms_lower_deg``
     (both shoulders' lowest abduction) and the local solver's
     ``iterations``, ``start``, ``elbows``, ``hands``, ``placements_within`` and ``pitch``,
-    and ``measurement_prior``.
+    ``measurement_prior`` and ``mass_scaling``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -91,4 +91,5 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
                                placement_rounds=given.get("placement_rounds",
                                                           base.placement_rounds),
                                measurement_prior=given.get("measurement_prior",
-                                                           base.measurement_prior))
+                                                           base.measurement_prior),
+                               mass_scaling=given.get("mass_scaling", base.mass_scaling))

@@ -94,6 +94,7 @@ def run_record(inputs: PersonInputs, settings: FitSettings, model: BodyModel, fi
             "elbow_deg": result.elbow_deg,
             "hand_twist_deg": (None if result.hand_twist_deg is None
                                else dict(zip(("left", "right"), result.hand_twist_deg.tolist()))),
+            "mass_scale": fit.mass_scale,
             "evaluations": result.evaluations,
             "generations": result.generations,
             "stop_reasons": {k: str(v) for k, v in result.stop_reasons.items()},

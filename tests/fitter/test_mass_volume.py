@@ -1,0 +1,70 @@
+"""The girths scaled to the mass (fitter/fit/mass_volume.py): the volume against trimesh's,
+the scale against a body actually scaled across, and a fit given its body's own mass."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+import trimesh
+
+from bodyfit.fitter.demo.studio_photos import write_subject
+from bodyfit.fitter.fit.mass_volume import (DENSITY_KG_PER_L, SCALED, mass_scale, mass_scaled,
+                                            mesh_volume_l)
+from bodyfit.fitter.fit.person import PersonInputs
+from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
+from bodyfit.kernels.body_forward import rest_shape
+
+BETAS = np.array([1.2, 0.9, -0.7, 0.4, 0.6] + [0.0] * 15)
+
+
+@pytest.fixture(scope="module")
+def body(body_model):
+    return rest_shape(body_model, BETAS[None])[0][0].astype(np.float64)
+
+
+def test_the_volume_is_trimeshs(body_model, body):
+    for vertices in (body_model.mean_vertices, body):
+        mesh = trimesh.Trimesh(vertices, body_model.faces, process=False)
+        assert mesh.is_watertight
+        assert mesh_volume_l(vertices, body_model.faces) == pytest.approx(1000 * mesh.volume,
+                                                                          rel=1e-9)
+        assert 40 < mesh_volume_l(vertices, body_model.faces) < 150
+
+
+def test_the_scale_is_the_bodys_scaled_across(body_model, measurer, body):
+    """The body scaled across by 1.08 has 1.08^2 its volume; given that mass, the fit's body
+    scales by 1.08, and its horizontal girths are the scaled body's."""
+    across = body * np.array([1.08, 1.08, 1.0])
+    litres = mesh_volume_l(across, body_model.faces)
+    assert litres == pytest.approx(1.08 ** 2 * mesh_volume_l(body, body_model.faces))
+    scale = mass_scale(litres * DENSITY_KG_PER_L, body, body_model.faces)
+    assert scale == pytest.approx(1.08)
+    measured = measurer.measure(body.astype(np.float32))
+    scaled = mass_scaled(measured, scale)
+    wider = measurer.measure(across.astype(np.float32))
+    for key in ("D", "E", "F", "L"):  # horizontal sections: exactly the scaled body's
+        assert scaled[key] == pytest.approx(wider[key], rel=2e-3), key
+    for key in set(measured) - set(SCALED):
+        assert scaled[key] == measured[key]
+
+
+def test_a_fit_given_its_bodys_mass_keeps_its_girths_near_the_truth(body_model, tmp_path):
+    truth = write_subject(tmp_path, body_model, BETAS, np.array([6.0, 6.0, 3.0, 3.0]))
+    true_body = rest_shape(body_model, BETAS[None])[0][0]
+    mass = DENSITY_KG_PER_L * mesh_volume_l(true_body, body_model.faces)
+    settings = dataclasses.replace(FitSettings(), projection="orthographic",
+                                   measurement_prior="none")
+    inputs = PersonInputs(str(tmp_path / "front.png"), str(tmp_path / "side.png"),
+                          truth["O"] / 10, check=False)
+    plain = fit_inputs(body_model, inputs, settings, progress=False)
+    weighed = fit_inputs(body_model, dataclasses.replace(inputs, mass_kg=mass), settings,
+                         progress=False)
+    assert plain.mass_scale is None
+    assert weighed.mass_scale == pytest.approx(1.0, abs=0.03)  # the fit's volume is right
+    for key, value in plain.measurements.items():
+        expected = value * weighed.mass_scale if key in SCALED else value
+        assert weighed.measurements[key] == pytest.approx(expected, rel=1e-9), key
+    assert np.mean([abs(weighed.measurements[k] - truth[k]) for k in "DEF"]) < 8.0
+    off = fit_inputs(body_model, dataclasses.replace(inputs, mass_kg=1.2 * mass),
+                     settings, progress=False)
+    assert off.mass_scale == pytest.approx(np.sqrt(1.2) * weighed.mass_scale, rel=1e-9)
