@@ -72,5 +72,7 @@ def test_runs_recorded_before_the_prior_repeat_without_it():
     record = {"inputs": {"front": "f.png", "side": "s.png", "height_cm": 170.0},
               "settings": {"projection": "orthographic"}}
     assert run_config(record).settings.measurement_prior == "none"
-    record["settings"] = {"measurement_prior": "ansur"}
+    assert run_config(record).settings.mass_scaling == "none"  # nor the mass's scaling
+    record["settings"] = {"measurement_prior": "ansur", "mass_scaling": "girths"}
     assert run_config(record).settings.measurement_prior == "ansur"
+    assert run_config(record).settings.mass_scaling == "girths"

@@ -133,6 +133,7 @@ def test_run_json_round_trips_into_the_same_settings(first_run):
                               refine_components=0),
         solver=SolverSettings(),  # the run's --method thorough: no local solver
         projection="orthographic", measurement_prior="none",  # thorough's: the fit's own
+        mass_scaling="none",
         cost=dataclasses.replace(FitSettings().cost, part_weights=tuple(weights)))
     assert config.inputs.front.endswith("front.png") and config.output == first_run
     custom = FitSettings(search=SearchSettings(pose_lower_deg=(-5.0,) * 4, components=12),
