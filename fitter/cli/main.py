@@ -19,6 +19,7 @@ from bodyfit.common.command_line import OneLineArgumentParser, bodyfit_version
 from bodyfit.common.errors import UserError
 from bodyfit.common.files import check_input_file
 from bodyfit.fitter.fit.facing import SIDE_FROM, side_text
+from bodyfit.fitter.fit.mass_volume import MASS_SCALINGS
 from bodyfit.fitter.fit.pitch import PITCHES, pitch_text
 
 __all__ = ["main"]
@@ -63,8 +64,9 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
         parser.add_argument("--height-cm", type=float, metavar="CM",
                             help="the person's stature, centimetres")
         parser.add_argument("--mass-kg", type=float, metavar="KG",
-                            help="the person's body mass, kilograms (optional): the "
-                                 "measurements' prior reads it with the stature and sex")
+                            help="the person's body mass, kilograms (optional): the girths "
+                                 "are scaled to it (--mass-scaling), and the measurements' "
+                                 "prior reads it with the stature and sex")
         parser.add_argument("-o", "--output", type=Path, metavar="OUT",
                             help="output folder (created; must be empty unless --overwrite)")
     parser.add_argument("--camera", metavar="camera.json",
@@ -168,7 +170,7 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "by its ±, so a fit that matched the silhouettes poorly leans "
                              "on them; none: the fit's own (the default before; --method "
                              "thorough's and paper's)")
-    parser.add_argument("--mass-scaling", choices=("girths", "none"),  # MASS_SCALINGS
+    parser.add_argument("--mass-scaling", choices=MASS_SCALINGS,
                         help="with --mass-kg: girths (the default) scales the "
                              "circumferences so that the fitted body's volume at 1.0 kg/L "
                              "is the mass, before the prior; none: the prior alone reads "

@@ -70,7 +70,8 @@ class PersonInputs:
             :data:`bodyfit.calib.segmenters.SEGMENTERS`.
         check: run the photography check (:mod:`bodyfit.fitter.check.photos`) before
             the fit (``--no-check``: False).
-        mass_kg: the body's mass, kilograms, or None (read by the measurements' prior,
+        mass_kg: the body's mass, kilograms, or None (the girths are scaled to it,
+            :mod:`bodyfit.fitter.fit.mass_volume`, and the measurements' prior reads it,
             :mod:`bodyfit.fitter.fit.measurement_prior`).
         side_from: which side of the person the side photo shows, one of
             :data:`~bodyfit.fitter.fit.facing.SIDE_FROM`.

@@ -184,7 +184,7 @@ def fit_page(record: FitRecord, photos: dict, camera: str | None) -> str:
     """A fit: its progress while queued or fitting (polled), its reasons when it failed,
     its report when done (``photos``: run.json's record of what was read of the photos;
     ``camera``: the registered camera's name, or None)."""
-    title = f"{record.person}, {record.created.replace('T', ' ')}"
+    title = f"{record.person}, {record.created}"
     given = (f"<p>Stature {record.height_cm:g} cm, sex {_e(record.sex)}"
              + (f", mass {record.mass_kg:g} kg" if record.mass_kg else "") + "</p>")
     if record.state in ("queued", "fitting"):
@@ -218,7 +218,7 @@ def _quote(person: str) -> str:
 def people_page(people: list[tuple[str, int, str | None]], query: str) -> str:
     """The people measured, searchable by id or name."""
     rows = "".join(f"<tr><td><a href='/people/{_quote(p)}'>{_e(p)}</a></td>"
-                   f"<td class=num>{n}</td><td>{_e((latest or '').replace('T', ' '))}</td></tr>"
+                   f"<td class=num>{n}</td><td>{_e(latest or '')}</td></tr>"
                    for p, n, latest in people)
     body = (f"<form method=get><label>Search by id or name <input type=text name=q "
             f"value='{_e(query)}'></label></form>"
@@ -230,7 +230,7 @@ def people_page(people: list[tuple[str, int, str | None]], query: str) -> str:
 def person_page(person: str, fits: list[FitRecord]) -> str:
     """A person's fits over time, each measurement with its change since the fit before."""
     done = [f for f in fits if f.state == "done"]
-    head = "".join(f"<th><a href='/fits/{f.fit_id}'>{_e(f.created.replace('T', ' '))}</a></th>"
+    head = "".join(f"<th><a href='/fits/{f.fit_id}'>{_e(f.created)}</a></th>"
                    for f in done)
     rows = []
     for key, (name, label) in MEASUREMENTS.items():
@@ -244,7 +244,7 @@ def person_page(person: str, fits: list[FitRecord]) -> str:
             cells.append(f"<td class=num>{value / 10:.1f}{change}</td>")
             before = value
         rows.append(f"<tr><td>{key}</td><td>{_e(label)}</td>{''.join(cells)}</tr>")
-    others = "".join(f"<li><a href='/fits/{f.fit_id}'>{_e(f.created.replace('T', ' '))}</a>: "
+    others = "".join(f"<li><a href='/fits/{f.fit_id}'>{_e(f.created)}</a>: "
                      f"{_e(f.state)} {_e(f.reason)}</li>" for f in fits if f.state != "done")
     body = ("<p>Centimetres; in brackets, the change since the fit before.</p>"
             + (f"<table><tr><th></th><th>measurement</th>{head}</tr>{''.join(rows)}</table>"
@@ -280,7 +280,7 @@ document.getElementById('calibrate').addEventListener('submit', async (event) =>
 def cameras_page(cameras) -> str:
     """The registered cameras, and a form to calibrate one from board photos."""
     rows = "".join(f"<tr><td>{_e(row['name'])}</td><td class=num>{row['rms_px']:.3f}</td>"
-                   f"<td>{_e(row['views'])}</td><td>{_e(row['created'].replace('T', ' '))}"
+                   f"<td>{_e(row['views'])}</td><td>{_e(row['created'])}"
                    f"</td></tr>" for row in cameras)
     body = ((f"<table><tr><th>camera</th><th>RMS px</th><th>views</th><th>calibrated</th></tr>"
              f"{rows}</table>" if cameras else "<p>No camera registered: fits use each "

@@ -14,6 +14,7 @@ A worker that dies fails the fits it may have been running, not the others.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import statistics
 import threading
@@ -35,7 +36,6 @@ FIRST_FIT_S = 40.0
 #: The done fits whose median time predicts the next one's.
 _RECENT = 10
 RESULT = "result"
-PHOTOS = ("front", "side")
 
 
 def fit_folder(data: Path, fit_id: int) -> Path:
@@ -48,13 +48,16 @@ def camera_file(data: Path, camera_id: int) -> Path:
     return Path(data) / "cameras" / str(int(camera_id)) / "camera.json"
 
 
+@dataclasses.dataclass(frozen=True)
 class FitProgress:
     """Where a fit stands: its ``state`` (:data:`~bodyfit.fitter.serve.store.FIT_STATES`),
     ``ahead`` (fits before it in the queue), ``elapsed_s`` (fitting for) and ``left_s``
     (the time left, from the studio's recent fits; 0 when overdue)."""
 
-    def __init__(self, state: str, ahead: int = 0, elapsed_s: float = 0.0, left_s: float = 0.0):
-        self.state, self.ahead, self.elapsed_s, self.left_s = state, ahead, elapsed_s, left_s
+    state: str
+    ahead: int = 0
+    elapsed_s: float = 0.0
+    left_s: float = 0.0
 
     def as_json(self) -> dict:
         return {"state": self.state, "ahead": self.ahead, "elapsed_s": round(self.elapsed_s, 1),

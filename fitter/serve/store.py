@@ -49,7 +49,7 @@ CREATE TABLE IF NOT EXISTS cameras (
 
 
 def _now() -> str:
-    return datetime.datetime.now().isoformat(timespec="seconds")
+    return datetime.datetime.now().isoformat(sep=" ", timespec="seconds")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,7 +59,7 @@ class FitRecord:
     Attributes:
         fit_id: the fit's number (its folder's name).
         person: who was measured, as typed.
-        created: when it was asked for, ISO 8601 local time.
+        created: when it was asked for, local time, "YYYY-MM-DD HH:MM:SS".
         state: one of :data:`FIT_STATES`; reason: why it failed, one line.
         height_cm, sex, mass_kg: the inputs given (mass None: not given).
         camera: the registered camera's id, or None (the photos' EXIF focal length).
