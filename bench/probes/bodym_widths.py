@@ -110,8 +110,9 @@ def main(argv: list[str] | None = None) -> None:
                       f"{np.median(mb[inside] / fb[inside]):.3f} | "
                       f"{np.median(md[inside] / fd[inside]):.3f}")
         ellipse = ellipse_perimeter(mb, md)
-        print(f"{key}: correlation with the scan's girth: the fit's {np.corrcoef(value, truth)[0, 1]:.2f}, "
-              f"the mask's ellipse {np.corrcoef(ellipse, truth)[0, 1]:.2f}")
+        print(f"{key}: correlation with the scan's girth: the fit's "
+              f"{np.corrcoef(value, truth)[0, 1]:.2f}, the mask's ellipse "
+              f"{np.corrcoef(ellipse, truth)[0, 1]:.2f}")
 
 
 if __name__ == "__main__":

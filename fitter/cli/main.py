@@ -164,6 +164,11 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "run again with each camera pitched 4 degrees down and up, the "
                              "best-scored answer kept; about twice the time) or level (both "
                              "cameras level, the default before)")
+    parser.add_argument("--shape-prior", type=float, metavar="SHARE",
+                        help="the local solver's Gaussian prior on the shape grows by this "
+                             "share of the silhouettes' misfit (mm^2 of cost per sigma^2 "
+                             "of each shape component per mm^2 of misfit; default "
+                             "0.00125; 0: a fixed weak prior, the default before)")
     parser.add_argument("--measurement-prior", choices=("ansur", "none"),  # PRIORS
                         help="ansur (the default): each measurement weighed against what "
                              "ANSUR II's adults of the stature, sex (and --mass-kg) measure, "

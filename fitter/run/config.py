@@ -118,8 +118,9 @@ def _without_solver(settings):
 
 
 def _without_prior(settings):
-    """run.json's ``settings`` object with the measurements' prior and the mass scaling
-    off when it names none: a run from before them (docs/history.md). Anything else is
+    """run.json's ``settings`` object with the measurements' prior, the mass scaling and
+    the shape prior's share of the misfit off when it names none: a run from before them
+    (docs/history.md). Anything else is
     returned as it is, for :func:`_build` to check."""
     if not isinstance(settings, dict):
         return settings
@@ -127,6 +128,9 @@ def _without_prior(settings):
         settings = {**settings, "measurement_prior": "none"}
     if "mass_scaling" not in settings:  # a run from before it
         settings = {**settings, "mass_scaling": "none"}
+    solver = settings.get("solver")
+    if isinstance(solver, dict) and "prior_per_cost" not in solver:  # before the shape's
+        settings = {**settings, "solver": {**solver, "prior_per_cost": 0.0}}
     return settings
 
 

@@ -54,8 +54,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
     the weights) and ``weight`` (a list of ``NAME=VALUE`` overrides on top)), ``device``,
     ``threads``, ``side_arms``, ``projection``, ``placement_rounds``, ``arms_lower_deg``
     (both shoulders' lowest abduction) and the local solver's
-    ``iterations``, ``start``, ``elbows``, ``hands``, ``placements_within`` and ``pitch``,
-    ``measurement_prior`` and ``mass_scaling``.
+    ``iterations``, ``start``, ``elbows``, ``hands``, ``placements_within``, ``pitch`` and
+    ``shape_prior`` (its ``prior_per_cost``), ``measurement_prior`` and ``mass_scaling``.
 
     Raises:
         UserError: a bad weights preset, file or override.
@@ -83,6 +83,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
                                                  ("iterations", "start", "elbows", "hands",
                                                   "placements_within", "pitch")
                                                  if k in given})
+    if "shape_prior" in given:
+        solver = dataclasses.replace(solver, prior_per_cost=float(given["shape_prior"]))
     return dataclasses.replace(base, search=search, solver=solver, cost=cost,
                                device=given.get("device", base.device),
                                threads=given.get("threads", base.threads),

@@ -103,6 +103,42 @@ def test_outline_jacobian_matches_finite_differences(body_model, subject, name):
         assert not jacobian[:, :, 20:22].any()
 
 
+K = 10  # the components of the own-render problems
+
+
+def own_render_problem(body_model, model, folder, settings: SolverSettings,
+                       flexion: float | None = None, twist: float | None = None,
+                       grown_px: int = 0) -> LocalProblem:
+    """The local solver's problem whose silhouettes are the first ``K`` components of
+    ``BETAS`` in ``POSE`` (elbows bent to ``flexion``, the front photo's hands turned by
+    ``twist``; None: the rest pose's) rendered by the render ``model`` through the
+    subject's placed cameras, each grown by ``grown_px`` pixels (an outline no body of
+    the model follows)."""
+    from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
+
+    stature = float(np.ptp(rest_shape(body_model, BETAS[None, :K])[0][0][:, 2]))
+    extent = extreme_bodies(body_model, K, [-10.0] * 4, [30.0] * 4)
+    views = {}
+    for name in ("front", "side"):
+        options = {} if name == "front" else side_view_options(body_model, "down")
+        mean = forward(model, np.zeros((1, K)), np.zeros((1, 4)))[0]
+        placed = pinhole_view(name, person_mask(folder / f"{name}.png"), K_TRUE, stature,
+                              extent.reshape(-1, 3), mean, model.vertex_parts, **options)
+        body = elbow_forward(model, BETAS[None, :K], placed.view_pose(POSE[None]), flexion,
+                             view_twist(name, twist))[0]
+        faces, parts = visible_faces(model.faces, model.face_parts, placed.visible_parts)
+        own = rasterize(body[None], faces, parts, placed.camera, placed.height,
+                        placed.width).numpy()[0] >= 0
+        if grown_px:
+            own = cv2.dilate(own.astype(np.uint8), np.ones((3, 3), np.uint8),
+                             iterations=grown_px) > 0
+        views[name] = prepare_view_target(name, own, placed.camera,
+                                          placed.millimetres_per_pixel, **options)
+    conditioner = StatureConditioner(body_model, K, stature, 3.0, extent)
+    return LocalProblem(model, views, cost_settings("bodyfit"), conditioner, K,
+                        (-10.0,) * 4, (30.0,) * 4, 3.0, settings)
+
+
 @pytest.mark.parametrize("flexion, twist", [(None, None), (8.0, None), (8.0, 70.0)])
 def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, subject,
                                                          flexion, twist):
@@ -110,35 +146,15 @@ def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, s
     cameras, the body one of the solver's candidates (10 components; its elbows the rest
     pose's, or bent to 8 degrees and fitted; its front photo's hands the rest pose's, or
     turned 70 degrees towards palms forward and fitted); from the mean body, the solver
-    finds its shape and pose (and flexion, and twist) again."""
-    from bodyfit.fitter.fit.elbows import elbow_forward, view_twist
-
-    folder, truth = subject
+    finds its shape and pose (and flexion, and twist) again. The shape prior's share of
+    the misfit (the default's) vanishes as the misfit does."""
     model = render_model(body_model, 8.0)
-    k = 10
-    betas = np.r_[BETAS[:k]]
-    stature = float(np.ptp(rest_shape(body_model, betas[None])[0][0][:, 2]))
-    extent = extreme_bodies(body_model, k, [-10.0] * 4, [30.0] * 4)
-    views = {}
-    for name in ("front", "side"):
-        options = {} if name == "front" else side_view_options(body_model, "down")
-        mean = forward(model, np.zeros((1, k)), np.zeros((1, 4)))[0]
-        placed = pinhole_view(name, person_mask(folder / f"{name}.png"), K_TRUE, stature,
-                              extent.reshape(-1, 3), mean, model.vertex_parts, **options)
-        body = elbow_forward(model, betas[None], placed.view_pose(POSE[None]), flexion,
-                             view_twist(name, twist))[0]
-        faces, parts = visible_faces(model.faces, model.face_parts, placed.visible_parts)
-        own = rasterize(body[None], faces, parts, placed.camera, placed.height,
-                        placed.width).numpy()[0] >= 0
-        views[name] = prepare_view_target(name, own, placed.camera,
-                                          placed.millimetres_per_pixel, **options)
-    conditioner = StatureConditioner(body_model, k, stature, 3.0, extent)
-    settings = SolverSettings(iterations=40, components=k, placements=0,
+    settings = SolverSettings(iterations=40, components=K, placements=0,
                               elbows="rest" if flexion is None else "fitted",
                               hands="rest" if twist is None else "fitted")
-    problem = LocalProblem(model, views, cost_settings("bodyfit"), conditioner, k,
-                           (-10.0,) * 4, (30.0,) * 4, 3.0, settings)
+    problem = own_render_problem(body_model, model, subject[0], settings, flexion, twist)
     solved, trace = solve(problem, np.zeros(problem.num_genes))
+    betas = BETAS[:K]
     found_betas, found_pose, found_flexion, found_twist = problem.body(solved)
     if twist is None:
         assert found_twist is None
@@ -158,6 +174,26 @@ def test_the_solver_recovers_a_body_from_its_own_renders(body_model, measurer, s
         np.testing.assert_allclose(found_betas, betas, atol=0.15)
     assert max(map(abs, errors.values())) < (1.0 if flexion is None else 1.5), errors
     assert np.abs(solved[problem.camera_start:]).max() < 0.01  # the cameras stay, metres
+
+
+def test_the_shape_prior_grows_with_the_misfit(body_model, subject):
+    """Silhouettes grown by 4 pixels all round, which no body of the model follows
+    exactly: the prior's weight is the fixed part plus its share of the silhouette cost,
+    and solved with a large share the shape stays nearer the mean than without one."""
+    model = render_model(body_model, 8.0)
+    solved = {}
+    for share in (0.0, 0.02):
+        settings = SolverSettings(iterations=15, components=K, placements=0,
+                                  prior_per_cost=share)
+        problem = own_render_problem(body_model, model, subject[0], settings, grown_px=4)
+        x, _ = solve(problem, np.zeros(problem.num_genes))
+        residuals = problem.residuals(x)
+        misfit = problem.silhouette_cost(residuals, settings.huber_mm)
+        assert misfit > 10.0  # mm^2: the grown outline is not a body's
+        assert problem.prior_weight(residuals) == pytest.approx(settings.prior
+                                                                + share * misfit)
+        solved[share] = problem.body(x)[0][1:]  # the first beta is the stature's
+    assert solved[0.02] @ solved[0.02] < 0.5 * (solved[0.0] @ solved[0.0]), solved
 
 
 def test_settings_the_solver_cannot_fit_with_are_one_line_errors():

@@ -27,6 +27,7 @@ from bodyfit.fitter.output.body_views import BODY_BGR
 from bodyfit.fitter.output.overlays import _canvas_to_photo
 from bodyfit.fitter.output.render import PART_COLOURS_BGR
 from bodyfit.fitter.run.config import read_run_config, run_config
+from bodyfit.fitter.run.options import fit_settings
 from bodyfit.kernels import CostSettings
 
 BETAS = np.r_[0.5, np.zeros(19)]
@@ -148,12 +149,19 @@ def test_run_json_round_trips_into_the_same_settings(first_run):
 
 def test_run_json_from_before_the_solver_runs_without_it(first_run):
     """A run.json without ``settings.solver`` (written before the local solver) repeats
-    its population search alone, not the search and then today's solver."""
+    its population search alone, not the search and then today's solver; one whose solver
+    names no ``prior_per_cost`` (before the shape prior grew with the misfit) repeats
+    the fixed prior alone, and ``--shape-prior`` sets it."""
     record = json.loads((first_run / "run.json").read_text())
     del record["settings"]["solver"]
     assert run_config(record).settings.solver.iterations == 0
-    record["settings"]["solver"] = {"iterations": 12}
-    assert run_config(record).settings.solver == SolverSettings(iterations=12)
+    record["settings"]["solver"] = {"iterations": 12}  # and before the shape prior's share
+    assert run_config(record).settings.solver == SolverSettings(iterations=12,
+                                                                prior_per_cost=0.0)
+    record["settings"]["solver"] = {"iterations": 12, "prior_per_cost": 0.002}
+    assert run_config(record).settings.solver.prior_per_cost == 0.002
+    given = fit_settings(run_config(record).settings, {"shape_prior": 0.0})
+    assert given.solver == SolverSettings(iterations=12, prior_per_cost=0.0)
 
 
 def test_run_json_of_nine_parts_weighs_the_neck_as_its_head(first_run):
