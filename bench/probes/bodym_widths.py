@@ -52,7 +52,7 @@ def mask_width_mm(mask: np.ndarray, stature_mm: float, height_mm: float) -> floa
     middle = 0.5 * (cols.min() + cols.max())
     centre = bottom - height_mm / mm
     widths = []
-    for row in range(int(round(centre - _BAND_MM / mm)), int(round(centre + _BAND_MM / mm)) + 1):
+    for row in range(round(centre - _BAND_MM / mm), round(centre + _BAND_MM / mm) + 1):
         edges = np.flatnonzero(np.diff(np.r_[0, mask[row].astype(np.int8), 0]))
         runs = edges.reshape(-1, 2)
         if len(runs):
