@@ -152,9 +152,10 @@ class SolverSettings:
         if self.iterations and not 2 <= self.components <= stored_components:
             raise UserError(f"the local solver's components must be 2-{stored_components}, "
                             f"got {self.components}")
-        if (self.prior < 0 or self.prior_per_cost < 0 or self.huber_mm <= 0
-                or self.placements < 0 or self.placements_within < 0
-                or self.huber_start_mm < self.huber_mm):
+        if self.prior_per_cost < 0:
+            raise UserError(f"--shape-prior must be >= 0, got {self.prior_per_cost:g}")
+        if (self.prior < 0 or self.huber_mm <= 0 or self.placements < 0
+                or self.placements_within < 0 or self.huber_start_mm < self.huber_mm):
             raise UserError("the solver's prior and placements must be >= 0 and its "
                             "Huber knees > 0, the first at least the last")
         if not 0 <= self.person_to_model <= 1:

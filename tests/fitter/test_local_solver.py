@@ -208,6 +208,8 @@ def test_settings_the_solver_cannot_fit_with_are_one_line_errors():
     with pytest.raises(UserError, match="--refine-components refines the searches"):
         dataclasses.replace(default, search=dataclasses.replace(
             default.search, refine_components=50)).validate(60)
+    with pytest.raises(UserError, match="--shape-prior must be >= 0, got -1"):
+        SolverSettings(iterations=40, prior_per_cost=-1.0).validate(60)
     METHODS["thorough"].validate(60)  # the population search alone
 
 
