@@ -33,13 +33,14 @@ from bench.bodym.cli import RUNS
 from bench.bodym.dataset import DEFAULT_SPLIT, part, read_split
 from bench.bodym.scores import BMI_BANDS
 from bodyfit.calib.silhouette import load_mask
+from bodyfit.fitter.fit.search import SearchSettings
 from bodyfit.fitter.measure.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model.cache import load_model
 from bodyfit.fitter.output.mesh_io import read_mesh
 
 _GIRTHS = ("D", "E", "F")
 _BAND_MM = 5.0
-_LIMIT = 2.99  # |beta| at the +-3 sigma bound
+_LIMIT = SearchSettings().beta_limit - 0.01  # |beta| at its bound
 
 
 def mask_width_mm(mask: np.ndarray, stature_mm: float, height_mm: float) -> float:

@@ -427,6 +427,12 @@ class LocalProblem:
         betas = x[:self.k - 1]
         return self.silhouette_cost(residuals, knee) + prior * float(betas @ betas)
 
+    def cost_of(self, x: np.ndarray) -> float:
+        """The cost (mm^2) of the parameters ``x`` at the last knee, its prior weighed
+        where ``x`` leaves the silhouettes (one render a view)."""
+        residuals = self.residuals(x)
+        return self.cost(residuals, x, self.settings.huber_mm, self.prior_weight(residuals))
+
 
 def solve(problem: LocalProblem, start: np.ndarray, place=None,
           flexion_deg: float | None = None, twist_deg: np.ndarray | None = None

@@ -523,7 +523,7 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
             for name, view in views.items()})
     genes = np.array(trace.genes) if trace.genes else start[None]
     # the solver's cost per iteration; with none (the learned start alone), the start's
-    costs = np.array(trace.costs or [_start_cost(problem, solved)])
+    costs = np.array(trace.costs or [problem.cost_of(solved)])
     per_iteration = conditioner.complete(genes[:, :solver.components - 1],
                                          genes[:, solver.components - 1:])
     result = SearchResult(
@@ -558,13 +558,6 @@ def _pitch_searched(model, views, masks, intrinsics, stature_m, sex: str,
     (answer, answer_views), _ = searched_pitches(solve_at, (level.cost, (level, dict(views))))
     views.update(answer_views)
     return dataclasses.replace(answer, evaluations=sum(evaluations))
-
-
-def _start_cost(problem: LocalProblem, x: np.ndarray) -> float:
-    """The local solver's cost (mm^2) of the parameters ``x``, as its iterations score."""
-    residuals = problem.residuals(x)
-    return problem.cost(residuals, x, problem.settings.huber_mm,
-                        problem.prior_weight(residuals))
 
 
 def fitted_bodies(model: BodyModel, betas: np.ndarray, pose_deg: np.ndarray,

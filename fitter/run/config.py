@@ -120,8 +120,7 @@ def _without_solver(settings):
 def _without_prior(settings):
     """run.json's ``settings`` object with the measurements' prior, the mass scaling and
     the shape prior's share of the misfit off when it names none: a run from before them
-    (docs/history.md). Anything else is
-    returned as it is, for :func:`_build` to check."""
+    (docs/history.md). Anything else is returned as it is, for :func:`_build` to check."""
     if not isinstance(settings, dict):
         return settings
     if "measurement_prior" not in settings:
