@@ -169,6 +169,10 @@ def _add_fit_options(parser: argparse.ArgumentParser, batch: bool) -> None:
                              "share of the silhouettes' misfit (mm^2 of cost per sigma^2 "
                              "of each shape component per mm^2 of misfit; default "
                              "0.00125; 0: a fixed weak prior, the default before)")
+    parser.add_argument("--beta-limit", type=float, metavar="SIGMA",
+                        help="the shape components span +-SIGMA standard deviations (the "
+                             "search's and the local solver's bounds, and the canvases' "
+                             "room; default 3, the paper's)")
     parser.add_argument("--measurement-prior", choices=("ansur", "none"),  # PRIORS
                         help="ansur (the default): each measurement weighed against what "
                              "ANSUR II's adults of the stature, sex (and --mass-kg) measure, "
@@ -226,6 +230,9 @@ def _build_parser() -> argparse.ArgumentParser:
     build.add_argument("--samples", type=int, default=3000,
                        help="bodies in the sample, half men, half women (default 3000)")
     build.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    build.add_argument("--girth-spread", type=float, default=1.0, metavar="FACTOR",
+                       help="draw the sample's circumferences FACTOR times as widely as "
+                            "ANSUR II's soldiers' (default 1)")
     build.add_argument("-o", "--output", type=Path,
                        help="write the model here instead of the cache (.npz); "
                             "fitter/data/body_model.npz is the model bodyfit ships")
@@ -356,10 +363,12 @@ def _cmd_model_build(args) -> None:
 
     from bodyfit.common.files import check_writable_dir
     from bodyfit.fitter.model.cache import model_path
+    from bodyfit.fitter.model_build.body_sample import SamplingSettings
     from bodyfit.fitter.model_build.builder import ModelBuildSettings, build_and_save
 
     settings = ModelBuildSettings(components=args.components, samples=args.samples,
-                                  seed=args.seed)
+                                  seed=args.seed,
+                                  sampling=SamplingSettings(girth_spread=args.girth_spread))
     settings.validate()
     path = args.output or model_path()
     if path.suffix != ".npz":

@@ -122,6 +122,8 @@ class SearchSettings:
                             "--searches 1 or more")
         if not all(lo < hi for lo, hi in zip(self.pose_lower_deg, self.pose_upper_deg)):
             raise UserError("every pose lower bound must lie below its upper bound")
+        if not self.beta_limit > 0:
+            raise UserError(f"--beta-limit must be above 0, got {self.beta_limit}")
         if not 0 < self.sigma0 <= 1:
             raise UserError(f"sigma0 must be in (0, 1], a fraction of each gene's range, "
                             f"got {self.sigma0}")

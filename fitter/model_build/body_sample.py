@@ -8,7 +8,10 @@ measurements*:
 1. targets: a draw from a multivariate normal with ANSUR II's per-sex means, standard
    deviations and correlations (``data/ansur2_stats.json``, z-scores clipped at +-3) of
    13 measurements (all of the paper's 16 but C, which ANSUR lacks, and the bicep and
-   forearm girths, which ANSUR takes flexed);
+   forearm girths, which ANSUR takes flexed); with ``SamplingSettings.girth_spread``
+   (``fitter model build --girth-spread``) the circumferences' z-scores are multiplied by
+   it, for bodies beyond the soldiers' range (at 1.5 BodyM's real people were fitted no
+   better: docs/accuracy.md, "Reach");
 2. a random start in Anny's parameters (phenotypes near the middle of their range,
    local changes near 0: the variation of what ANSUR does not constrain);
 3. quasi-Newton steps that move the parameters the least (in units of their scale)
@@ -32,8 +35,8 @@ from scipy.optimize import lsq_linear
 from bodyfit.fitter.measure.measurements import MEASUREMENTS, Measurer
 from bodyfit.fitter.model_build.anny_source import PHENOTYPES, SHAPE_PARAMETERS, AnnySource
 
-__all__ = ["SEXES", "TARGET_KEYS", "ReferenceStats", "SamplingSettings", "BodySample",
-           "BodySampler", "ANNY_GENDER"]
+__all__ = ["SEXES", "TARGET_KEYS", "GIRTH_TARGETS", "ReferenceStats", "SamplingSettings",
+           "BodySample", "BodySampler", "ANNY_GENDER"]
 
 logger = logging.getLogger(__name__)
 
@@ -42,6 +45,8 @@ SEXES = ("male", "female")
 ANNY_GENDER = {"male": 0.0, "female": 1.0}
 #: Measurements the sample's bodies are fitted to (see the module docstring).
 TARGET_KEYS = ("A", "B", "D", "E", "F", "G", "J", "K", "L", "M", "N", "O", "P")
+#: The targets' circumferences (all but the head's): what a body's build widens.
+GIRTH_TARGETS = ("B", "D", "E", "F", "G", "L", "M", "N")
 _KEYS = list(MEASUREMENTS)
 
 #: Centre, scale and bounds of each Anny parameter. Start values are drawn around the
@@ -99,10 +104,13 @@ class ReferenceStats:
         """(k, k) float64: the covariance of ``sex``'s columns, mm^2 (kg^2 for a mass)."""
         return self.correlation[sex] * np.outer(self.std[sex], self.std[sex])
 
-    def sample(self, sex: str, n: int, rng: np.random.Generator) -> np.ndarray:
-        """(n, k) float64 mm: multivariate normal draws, z-scores clipped at +-3."""
+    def sample(self, sex: str, n: int, rng: np.random.Generator,
+               widen: np.ndarray | None = None) -> np.ndarray:
+        """(n, k) float64 mm: multivariate normal draws, z-scores clipped at +-3, then
+        multiplied by ``widen`` ((k,), default 1: each column as wide as the table's)."""
         z = rng.multivariate_normal(np.zeros(len(self.keys)), self.correlation[sex], size=n)
-        return self.mean[sex] + np.clip(z, -3.0, 3.0) * self.std[sex]
+        factor = np.ones(len(self.keys)) if widen is None else np.asarray(widen, float)
+        return self.mean[sex] + np.clip(z, -3.0, 3.0) * factor * self.std[sex]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -115,6 +123,8 @@ class SamplingSettings:
     # moving one parameter by its scale
     local_change_spread: float = 0.1  # SD of the local changes' start values: the
     # variation the fitted measurements leave free (0.2 doubles the K=20 floor, docs/model.md)
+    girth_spread: float = 1.0  # the targets' circumferences (GIRTH_TARGETS) spread this
+    # many times ANSUR II's soldiers' (their z-scores multiplied): bodies beyond them
 
 
 @dataclasses.dataclass(frozen=True)
@@ -199,7 +209,8 @@ class BodySampler:
         pool = self._start(self.settings.pool_per_sex, rng, widen=2.0)
         jac = self._regress(pool, self._bodies(sex, pool, progress)[2][:, self._target_cols])
         jacobians = np.repeat(jac[None], n, axis=0)  # (n, k, D) mm per parameter unit
-        targets = self.stats.sample(sex, n, rng)
+        widen = np.where(np.isin(TARGET_KEYS, GIRTH_TARGETS), self.settings.girth_spread, 1.0)
+        targets = self.stats.sample(sex, n, rng, widen)
         start = self._start(n, rng)
         _, scale, lo, hi = self._prior
         # whitened least squares: rows scaled by 1 / (w * ANSUR SD), columns by the scale

@@ -59,6 +59,8 @@ class ModelBuildSettings:
         if not 1 <= self.components < self.samples:
             raise UserError(f"--components must be between 1 and the number of samples "
                             f"({self.samples}), got {self.components}")
+        if not self.sampling.girth_spread > 0:
+            raise UserError(f"--girth-spread must be above 0, got {self.sampling.girth_spread}")
 
 
 def template_body(source: AnnySource) -> tuple[np.ndarray, np.ndarray]:

@@ -101,10 +101,10 @@ def test_shipped_model_is_used_without_a_user_build(tmp_path, monkeypatch, body_
 
 def test_shipped_model_records_how_it_was_built(body_model):
     """The shipped model is the default build: `fitter model build -o
-    fitter/data/body_model.npz` with the default settings, Anny's version recorded."""
-    import dataclasses
-
-    assert body_model.metadata["settings"] == dataclasses.asdict(ModelBuildSettings())
+    fitter/data/body_model.npz` with the default settings (its metadata predates
+    ``girth_spread``, whose default it reads as), Anny's version recorded."""
+    assert ModelBuildSettings.of(body_model) == ModelBuildSettings()
+    assert "girth_spread" not in body_model.metadata["settings"]["sampling"]
     assert re.fullmatch(r"\d+\.\d+.*", body_model.metadata["anny_version"])
 
 
@@ -161,3 +161,20 @@ def test_principal_components_match_numpy_svd():
     np.testing.assert_allclose(np.abs(np.sum(comps * vt[:10], axis=1)), 1.0, atol=1e-5)
     np.testing.assert_allclose(scores, centred @ comps.T.astype(np.float64) / np.sqrt(eigvals),
                                atol=1e-4)
+
+
+def test_girth_spread_widens_only_the_circumference_targets():
+    """``SamplingSettings.girth_spread``'s draw: the same z-scores as the table's own,
+    the circumferences' multiplied by the spread, the lengths' left as they are."""
+    from bodyfit.fitter.model_build.body_sample import (GIRTH_TARGETS, TARGET_KEYS,
+                                                        ReferenceStats)
+
+    stats = ReferenceStats.load().subset(TARGET_KEYS)
+    widen = np.where(np.isin(TARGET_KEYS, GIRTH_TARGETS), 1.5, 1.0)
+    plain = stats.sample("female", 400, np.random.default_rng(3))
+    wide = stats.sample("female", 400, np.random.default_rng(3), widen)
+    mean, std = stats.mean["female"], stats.std["female"]
+    np.testing.assert_allclose(wide - mean, (plain - mean) * widen, rtol=1e-12, atol=1e-9)
+    assert np.abs((plain - mean) / std).max() <= 3.0 + 1e-9
+    assert np.abs((wide - mean) / std).max() > 3.5  # past the soldiers' +-3 SD
+    assert 1.3 < np.std(wide[:, TARGET_KEYS.index("E")]) / std[TARGET_KEYS.index("E")] < 1.7

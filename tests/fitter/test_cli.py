@@ -201,6 +201,7 @@ def test_measure_other_topology_exit_2(body_model, tmp_path, capsys):
 @pytest.mark.parametrize("argv,message", [
     (["model", "build", "--samples", "7"], "--samples"),
     (["model", "build", "--components", "0"], "--components"),
+    (["model", "build", "--girth-spread", "0"], "--girth-spread"),
     (["demo", "--method", "fast"], "--method"),
     (["demo", "-o", __file__], "is a file"),
     (["demo", "-o", f"{__file__}/inside"], "is a file"),  # a parent that is a file

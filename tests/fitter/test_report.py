@@ -284,3 +284,17 @@ def test_the_arms_lower_bound_is_the_defaults_and_replaced_by_name():
     assert METHODS["paper"].search.pose_lower_deg == (-10.0,) * 4
     before = fit_settings(METHODS["bodyfit"], {"arms_lower_deg": -10.0})
     assert before.search.pose_lower_deg == (-10.0,) * 4
+
+
+def test_the_beta_limit_bounds_the_search_and_sizes_the_canvases():
+    """--beta-limit sets the shape components' bounds and the canvases' room together
+    (a body past the canvases' extreme bodies could be cut by their edge); 0 is refused."""
+    from bodyfit.fitter.fit.person_fit import METHODS
+    from bodyfit.fitter.run.options import fit_settings
+
+    wide = fit_settings(METHODS["bodyfit"], {"beta_limit": 5.0})
+    assert wide.search.beta_limit == wide.canvas.beta_limit == 5.0
+    assert wide.search.upper[0] == 5.0 and wide.search.lower[0] == -5.0
+    assert METHODS["bodyfit"].canvas.beta_limit == METHODS["bodyfit"].search.beta_limit == 3.0
+    with pytest.raises(UserError, match="--beta-limit must be above 0"):
+        fit_settings(METHODS["bodyfit"], {"beta_limit": 0.0}).validate(40)
