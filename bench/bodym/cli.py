@@ -30,6 +30,7 @@ tables that ``report`` prints.
 from __future__ import annotations
 
 import argparse
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -215,7 +216,8 @@ def report(args) -> None:
     lines += _main_table(fits, removed, baseline)
     for photo_id, reason in everyone.failures:
         if photo_id in refused:
-            lines += ["", f"- refused: {reason}"]
+            # its numbers are the person's (a stated weight): aggregate tables only
+            lines += ["", f"- refused: {re.sub(r'[0-9]+([.][0-9]+)?', '#', reason)}"]
     lines += ["", "By body mass index (stated height and weight): people, then chest, waist, "
               "hip mean signed error / mean |error|, mm:", "",
               _row(["BMI", "people", "chest", "waist", "hip"]), _row(["---"] + ["---:"] * 4)]

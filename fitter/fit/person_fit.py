@@ -678,9 +678,11 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     measurements = fitted_measurements(model, measurer, settings, rest, view_bodies, views,
                                        masks, intrinsics)
     scale = None
-    if mass_kg is not None and settings.mass_scaling == "girths":
-        scale = mass_scale(mass_kg, rest, model.faces)
-        measurements = mass_scaled(measurements, scale)
+    if mass_kg is not None:
+        across = mass_scale(mass_kg, rest, model.faces)  # refuses another body's mass
+        if settings.mass_scaling == "girths":
+            scale = across
+            measurements = mass_scaled(measurements, scale)
     calibrated = calibration_applies(settings, METHODS["bodyfit"])
     if calibrated or not s.searches:  # the solver alone has no population to measure
         spreads = bodyfit_calibration().spreads(answer_cost(result))

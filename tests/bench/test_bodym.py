@@ -163,3 +163,11 @@ def test_fit_and_report_two_people_end_to_end(tmp_path, monkeypatch, body_model,
     assert f"| D chest circumference | {chest.mae[i]:.1f} | " in text
     assert "Repeat photos (1 subjects with two or more fitted pairs, 3 pairs)" in text
 
+    # a refusal's reason is printed with its numbers (the person's own) left out
+    (cli.RUNS / "two" / "failures.csv").write_text(
+        'id,reason\np0a,"--mass-kg 28.7 is 0.5 times what the body in the photos weighs '
+        '(about 58 kg): give this person\'s mass in kilograms, or leave it out"\n')
+    cli.main(["report", "two", "--split", str(split), "--first", "2"])
+    text = capsys.readouterr().out
+    assert ("- refused: --mass-kg # is # times what the body in the photos weighs (about "
+            "# kg)") in text and "28.7" not in text

@@ -9,8 +9,9 @@ import pytest
 import trimesh
 
 from bodyfit.fitter.demo.studio_photos import write_subject
-from bodyfit.fitter.fit.mass_volume import (DENSITY_KG_PER_L, SCALED, mass_scale, mass_scaled,
-                                            mesh_volume_l)
+from bodyfit.common.errors import UserError
+from bodyfit.fitter.fit.mass_volume import (DENSITY_KG_PER_L, MASS_MISMATCH, SCALED, mass_scale,
+                                            mass_scaled, mesh_volume_l)
 from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import FitSettings, fit_inputs
 from bodyfit.kernels.body_forward import rest_shape
@@ -50,6 +51,21 @@ def test_the_scale_is_the_bodys_scaled_across(body_model, measurer, body):
         assert scaled[key] == pytest.approx(wider[key], rel=2e-3), key
     for key in set(measured) - set(SCALED):
         assert scaled[key] == measured[key]
+
+
+def test_a_mass_not_the_bodys_is_refused(body_model, body):
+    """A mass within MASS_MISMATCH of what the body holds scales it; pounds given as
+    kilograms (2.2 times), or under 1 / MASS_MISMATCH of it, are refused in one line."""
+    held = DENSITY_KG_PER_L * mesh_volume_l(body, body_model.faces)
+    for factor in (0.99 * MASS_MISMATCH, 1.01 / MASS_MISMATCH):
+        assert mass_scale(factor * held, body, body_model.faces) == pytest.approx(
+            np.sqrt(factor))
+    for factor in (2.2, 1.01 * MASS_MISMATCH, 0.99 / MASS_MISMATCH):
+        with pytest.raises(UserError, match=rf"--mass-kg {factor * held:g} is .* times what "
+                                            rf"the body in the photos weighs \(about "
+                                            rf"{held:.0f} kg\): give this person's mass in "
+                                            "kilograms"):
+            mass_scale(factor * held, body, body_model.faces)
 
 
 def test_a_fit_given_its_bodys_mass_keeps_its_girths_near_the_truth(body_model, tmp_path):

@@ -246,6 +246,9 @@ def test_weight_override_reaches_the_cost(subject, tmp_path, capsys):
     ({"--side-arms": "up"}, "invalid choice"),
     ({"--threads": "0"}, "--threads"),
     ({"--mass-kg": "350"}, "--mass-kg must be a body mass in kilograms, 25-300; got 350"),
+    ({"--mass-kg": "160"}, r"--mass-kg 160 is 2\.0 times what the body in the photos "
+                           r"weighs \(about 8\d kg\): give this person's mass in kilograms"),
+    ({"--mass-kg": "30"}, r"--mass-kg 30 is 0\.4 times what the body"),
     ({"--measurement-prior": "soldiers"}, "invalid choice"),
     ({"--iterations": "-1"}, "--iterations must be >= 0"),
     ({"--iterations": "0", "--start": "mean"}, "--searches 0 needs the local solver"),
