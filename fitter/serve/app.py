@@ -41,8 +41,8 @@ from bodyfit.common.errors import UserError
 from bodyfit.fitter.batch.engines import WorkerSetup
 from bodyfit.fitter.fit.person import PersonInputs, checked_photo
 from bodyfit.fitter.measure.measurements import MEASUREMENTS
-from bodyfit.fitter.serve.pages import (PICTURES, RESULT_FILES, cameras_page, fit_page,
-                                        measure_page, people_page, person_page)
+from bodyfit.fitter.serve.pages import (PICTURES, RESULT_FILES, as_fields, cameras_page,
+                                        fit_page, measure_page, people_page, person_page)
 from bodyfit.fitter.serve.queue import RESULT, FitQueue, camera_file, fit_folder
 from bodyfit.fitter.serve.store import Store
 from bodyfit.fitter.serve.uploads import MAX_UPLOAD_BYTES, store_photo
@@ -52,17 +52,6 @@ __all__ = ["COOKIE", "create_app"]
 COOKIE = "bodyfit_token"
 _MAX_PERSON = 100
 _MAX_BOARD_PHOTOS = 40
-#: `fitter run`'s options, as the page's fields are called.
-_FIELDS = {"--height-cm": "the stature", "--mass-kg": "the mass", "--sex": "the sex",
-           "--board": "the board", "--square-mm": "the square's side"}
-
-
-def _as_fields(error: UserError) -> str:
-    """The error's line with the command line's option names as the page's fields."""
-    line = str(error)
-    for option, field in _FIELDS.items():
-        line = line.replace(option, field)
-    return line
 _VIEWS = ("front", "side")
 
 
@@ -171,7 +160,7 @@ async def start_fit(request: Request) -> JSONResponse:
                               mass_kg=_number(form, "mass_kg", "mass in kilograms", False))
         inputs.validate()
     except UserError as error:
-        return _problems([_as_fields(error)])
+        return _problems([as_fields(str(error))])
     fit_id = studio.store.add_fit(person, inputs.height_cm, inputs.sex, inputs.mass_kg,
                                   camera_id)
     folder = fit_folder(studio.data, fit_id)
@@ -288,7 +277,7 @@ async def calibrate(request: Request) -> JSONResponse:
             work / "coverage.png", ["fitter serve", "calibrate", name])
     except UserError as error:
         shutil.rmtree(work, ignore_errors=True)
-        return _problems([_as_fields(error)])
+        return _problems([as_fields(str(error))])
     views = describe_views(calibration.views)
     camera_id = studio.store.add_camera(name, calibration.rms_px, views)
     work.rename(camera_file(studio.data, camera_id).parent)

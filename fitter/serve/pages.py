@@ -14,7 +14,19 @@ from bodyfit.fitter.measure.measurements import MEASUREMENTS
 from bodyfit.fitter.serve.store import FitRecord
 
 __all__ = ["page", "measure_page", "fit_page", "people_page", "person_page", "cameras_page",
-           "RESULT_FILES", "PICTURES"]
+           "as_fields", "RESULT_FILES", "PICTURES"]
+
+#: `fitter run`'s options, as the page's fields are called.
+_FIELDS = {"--height-cm": "the stature", "--mass-kg": "the mass", "--sex": "the sex",
+           "--board": "the board", "--square-mm": "the square's side"}
+
+
+def as_fields(line: str) -> str:
+    """A one-line error with the command line's option names as the page's fields."""
+    for option, field in _FIELDS.items():
+        line = line.replace(option, field)
+    return line
+
 
 #: The fit's outputs offered for download, and the report's pictures (file -> label).
 RESULT_FILES = {"mesh.obj": "mesh (OBJ)", "mesh.ply": "mesh (PLY)",

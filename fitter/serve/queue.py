@@ -26,6 +26,7 @@ from bodyfit.fitter.batch.engines import WorkerSetup, local_pool, run_local_job
 from bodyfit.fitter.batch.job import SubjectJob, SubjectOutcome
 from bodyfit.fitter.fit.person import PersonInputs
 from bodyfit.fitter.fit.person_fit import METHODS
+from bodyfit.fitter.serve.pages import as_fields
 from bodyfit.fitter.serve.store import FitRecord, Store
 
 __all__ = ["FIRST_FIT_S", "FitQueue", "FitProgress", "camera_file", "fit_folder", "RESULT"]
@@ -138,7 +139,7 @@ class FitQueue:
             self.store.set_state(fit_id, "done", seconds=outcome.seconds or None,
                                  measurements=measured)
         else:
-            self.store.set_state(fit_id, "failed", outcome.reason)
+            self.store.set_state(fit_id, "failed", as_fields(outcome.reason))
         with self._lock:
             if fit_id in self._pending:
                 self._pending.remove(fit_id)

@@ -218,8 +218,18 @@ def test_a_person_measured_twice_through_a_calibrated_camera(scene, tmp_path):
             fits.append(client.post("/api/fits", data={
                 "person": "Ann", "height_cm": f"{scene.truth['O'] / 10:g}", "sex": "unknown",
                 "camera": str(camera["camera"]), **keys}).json()["fit"])
+        keys = {view: client.post(f"/api/photos/{view}", data={"camera": camera["camera"]},
+                                  files=_photo(getattr(scene, view))).json()["upload"]
+                for view in ("front", "side")}
+        heavy = client.post("/api/fits", data={  # pounds for kilograms: refused after its fit
+            "person": "Ann", "height_cm": f"{scene.truth['O'] / 10:g}", "sex": "unknown",
+            "mass_kg": "250", "camera": str(camera["camera"]), **keys}).json()["fit"]
         for fit_id in fits:
             assert _wait(client, fit_id)["state"] == "done"
+        refused = _wait(client, heavy)
+        assert refused["state"] == "failed" and re.fullmatch(
+            r"the mass 250 is \d\.\d times what the body in the photos weighs \(about \d+ "
+            r"kg\): give this person's mass in kilograms, or leave it out", refused["reason"])
         page = client.get(f"/fits/{fits[0]}").text
         assert "Camera: demo phone (calibrated)" in page
         shown = {name: float(value) for name, value in
