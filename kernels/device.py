@@ -1,18 +1,49 @@
 """Device selection and the argument checks shared by every kernel entry point.
 
 Shapes and dtypes are checked once, here, at the Python boundary; the kernels trust them.
-Nothing in this module touches Warp at import time (Warp initialises itself on first use).
+Nothing in this module touches Warp at import time (Warp initialises itself on first use,
+or a command line's :func:`init_warp`).
 """
 
 from __future__ import annotations
 
+import os
+import sys
+import tempfile
+
 import numpy as np
 import warp as wp
 
-__all__ = ["resolve_device", "device_array"]
+__all__ = ["NO_DRIVER_WARNING", "init_warp", "resolve_device", "device_array"]
+
+#: The start of what Warp's native library writes to stderr on a machine without NVIDIA's
+#: driver: the CPU path needs none, so a command line leaves it out (:func:`init_warp`).
+NO_DRIVER_WARNING = b"Warp CUDA warning: Could not find or load the NVIDIA CUDA driver"
 
 # numpy dtype kinds accepted for each kind of argument ('f' float, 'i'/'u' integer, 'b' bool)
 _ACCEPTED_KINDS = {"float": "fiu", "int": "iu", "bool": "b"}
+
+
+def init_warp() -> None:
+    """Initialise Warp for a command line: its log at errors only, and its native
+    library's start-up lines on stderr passed on but for :data:`NO_DRIVER_WARNING` (a
+    command's failure is then its own one line). Does nothing more once Warp is running."""
+    wp.config.log_level = wp.LOG_ERROR
+    wp.config.quiet = True
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as captured:
+        os.dup2(captured.fileno(), 2)
+        try:
+            wp.init()
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        captured.seek(0)
+        kept = [line for line in captured.read().splitlines(keepends=True)
+                if not line.startswith(NO_DRIVER_WARNING)]
+    if kept:
+        os.write(2, b"".join(kept))
 
 
 def resolve_device(device: str | wp.Device) -> wp.Device:

@@ -75,10 +75,9 @@ def start_worker(setup: WorkerSetup):
     """
     logging.basicConfig(level=setup.log_level, format="%(message)s")
     logging.getLogger("bodyfit").setLevel(setup.log_level)
-    import warp  # Warp prints its banner and module loads at INFO
+    from bodyfit.kernels.device import init_warp
 
-    warp.config.log_level = warp.LOG_ERROR
-    warp.config.quiet = True
+    init_warp()  # Warp's banner, module loads and no-driver warning: errors only
     if setup.threads is not None:
         import cv2
         import torch

@@ -769,9 +769,9 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(message)s")
     for chatty in ("anny", "bodyfit.calib"):  # their steps are logged for `calib -v`
         logging.getLogger(chatty).setLevel(logging.WARNING)
-    import warp  # Warp prints its banner and module loads at INFO; the CLI keeps to errors
+    from bodyfit.kernels.device import init_warp
 
-    warp.config.log_level = warp.LOG_ERROR
+    init_warp()  # Warp's banner, module loads and no-driver warning: the CLI keeps to errors
     command = {"batch": _cmd_batch, "check": _cmd_check, "demo": _cmd_demo,
                "measure": _cmd_measure, "run": _cmd_run, "serve": _cmd_serve}.get(args.command)
     if args.command == "model":
