@@ -81,7 +81,7 @@ class FitPhotos:
         stature_m = inputs.height_cm / 100.0
         views = person_views(model, masks, stature_m, settings, intrinsics,
                              extreme_bodies(model, s.components, s.pose_lower_deg,
-                                            s.pose_upper_deg, settings.canvas.beta_limit))
+                                            s.pose_upper_deg, s.beta_limit))
         return cls(settings, masks, intrinsics, views, stature_m,
                    record["result"].get("elbow_deg"), recorded_twist(record))
 

@@ -93,7 +93,7 @@ def combine(args) -> None:
         search = settings.search.refinement() if settings.search.refine_components \
             else settings.search
         bodies = extreme_bodies(model, search.components, search.pose_lower_deg,
-                                search.pose_upper_deg, settings.canvas.beta_limit)
+                                search.pose_upper_deg, search.beta_limit)
         conditioner = stature_conditioner(model, dataclasses.replace(settings, search=search),
                                           stature_m, bodies)
         genes = np.array([a["betas"] + [a["pose_deg"][n] for n in POSE_NAMES]

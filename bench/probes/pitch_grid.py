@@ -57,8 +57,7 @@ def subject_grid(model, measurer, set_folder: Path, row: dict) -> dict:
     masks, intrinsics, stature = photos.masks, photos.intrinsics, inputs.height_cm / 100
     s = settings.search
     bodies = extreme_bodies(model, person_fit._canvas_components(settings), s.pose_lower_deg,
-                            s.pose_upper_deg,
-                            settings.canvas.beta_limit)
+                            s.pose_upper_deg, s.beta_limit)
     views = person_fit.person_views(model, masks, stature, settings, intrinsics, bodies)
     level = person_fit._solved(model, views, masks, intrinsics, stature, inputs.sex,
                                settings, None, bodies)

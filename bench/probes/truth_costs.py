@@ -76,7 +76,7 @@ def compare_costs(model: BodyModel, run_json: Path, vertices: np.ndarray,
         s = dataclasses.replace(s, refine_components=s.components, refinements=1)
         settings = dataclasses.replace(settings, search=s)
     bodies = extreme_bodies(model, s.components, s.pose_lower_deg, s.pose_upper_deg,
-                            settings.canvas.beta_limit)
+                            s.beta_limit)
     views = person_views(model, masks, stature_m, settings, intrinsics, bodies)
     evaluator, conditioner = refinement_scoring(model, views, stature_m, settings)
     fit_betas, fit_pose = _genes(result)

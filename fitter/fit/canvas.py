@@ -11,9 +11,10 @@ canvases from the person's masks:
   Each view is scaled on its own, so the person's distance to the camera need not be
   known; a photo's perspective is not modelled (the orthographic approximation: at
   2.5-3.5 m a phone's perspective makes near parts a few per cent larger).
-- **Room for every candidate**: the canvas covers the model's extent over +-3 sigma of
-  each shape component and the whole pose range (both ends at once), plus a margin, so
-  no candidate is cut by the canvas edge (docs/kernels.md, Known limits). The model's
+- **Room for every candidate**: the canvas covers the model's extent over the search's
+  bound (``SearchSettings.beta_limit``, 3 sigma) of each shape component and the whole
+  pose range (both ends at once), plus a margin, so no candidate is cut by the canvas
+  edge (docs/kernels.md, Known limits). The model's
   origin is put where that extent fits; the person's silhouette is centred on where the
   mean body lands, and the kernels' alignment moves each candidate onto it.
 
@@ -53,12 +54,13 @@ class CanvasSettings:
             paper's canvases are 512 px high (:data:`PAPER_CANVAS`: 400 px of body leaves
             room for taller candidates).
         margin_px: free pixels around the largest candidate.
-        beta_limit: shape coefficients span +-this many standard deviations.
+
+    The candidates' room is the search's: :func:`extreme_bodies` at
+    ``SearchSettings.beta_limit``.
     """
 
     body_height_px: int = 600
     margin_px: int = 6
-    beta_limit: float = 3.0
 
     def validate(self) -> None:
         if not 32 <= self.body_height_px <= 2048:

@@ -410,7 +410,7 @@ def refinement_scoring(model: BodyModel, views: dict[str, kernels.ViewTarget],
     s = settings.search
     refinement = s.refinement()
     bodies = extreme_bodies(model, refinement.components, s.pose_lower_deg, s.pose_upper_deg,
-                            settings.canvas.beta_limit)
+                            s.beta_limit)
     return _scoring(model, views, dataclasses.replace(settings, search=refinement), stature_m,
                     bodies)
 
@@ -480,7 +480,7 @@ def _solved(model, views, masks, intrinsics, stature_m, sex: str, settings: FitS
                                search=dataclasses.replace(s, components=solver.components))
     bodies = canvas_bodies if _canvas_components(settings) == solver.components else \
         extreme_bodies(model, solver.components, s.pose_lower_deg, s.pose_upper_deg,
-                       settings.canvas.beta_limit)
+                       s.beta_limit)
     evaluator, conditioner = _scoring(model, views, at_k, stature_m, bodies)
     problem = LocalProblem(render_model(model, settings.render_cell_mm), views, settings.cost,
                            conditioner, solver.components, s.pose_lower_deg, s.pose_upper_deg,
@@ -654,7 +654,7 @@ def fit_person(model: BodyModel, masks: dict[str, np.ndarray], stature_m: float,
     s = settings.search
     t0 = time.perf_counter()
     bodies = extreme_bodies(model, _canvas_components(settings), s.pose_lower_deg,
-                            s.pose_upper_deg, settings.canvas.beta_limit)
+                            s.pose_upper_deg, s.beta_limit)
     views = person_views(model, masks, stature_m, settings, intrinsics, bodies)
     t1 = time.perf_counter()
     result = None

@@ -108,6 +108,16 @@ def _neck_as_head(settings):
     return {**settings, "cost": {**cost, "part_weights": neck_as_head}}
 
 
+def _canvas_without_limit(settings):
+    """run.json's ``settings`` object without ``canvas.beta_limit``: a run from when the
+    canvases held their own copy of the search's bound (always equal to it; the canvases'
+    room now follows ``search.beta_limit``). Anything else is returned as it is."""
+    canvas = settings.get("canvas") if isinstance(settings, dict) else None
+    if not (isinstance(canvas, dict) and "beta_limit" in canvas):
+        return settings
+    return {**settings, "canvas": {k: v for k, v in canvas.items() if k != "beta_limit"}}
+
+
 def _without_solver(settings):
     """run.json's ``settings`` object with the local solver off when it names none: a run
     from before the solver (docs/history.md), whose settings are the population search's
@@ -146,7 +156,8 @@ def run_config(record: dict, where: str = "run.json") -> RunConfig:
             raise UserError(f"{where}: missing {key!r}; is it a fitter run's run.json?")
     inputs = _build(PersonInputs, record["inputs"], f"{where}: inputs")
     settings = _build(FitSettings,
-                      _without_prior(_without_solver(_neck_as_head(record["settings"]))),
+                      _without_prior(_without_solver(_canvas_without_limit(
+                          _neck_as_head(record["settings"])))),
                       f"{where}: settings",
                       {"search": SearchSettings, "solver": SolverSettings,
                        "canvas": CanvasSettings, "cost": kernels.CostSettings})

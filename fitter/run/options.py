@@ -48,7 +48,7 @@ def base_settings(method: str | None, config: Path | None
 
 def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSettings:
     """``base`` with every fit option of ``options`` that is not None applied: the search's
-    (``SEARCH_OPTIONS``, ``free_stature``, ``beta_limit`` (the canvases' room too);
+    (``SEARCH_OPTIONS``, ``free_stature``, ``beta_limit`` (the canvases' room follows it);
     ``components`` at or above the base's ``refine_components``, that not given, turns the
     refinement off), the cost's
     (``matching``, ``vertical_anchor``, ``weights`` (a preset or a .toml file, replacing
@@ -70,10 +70,8 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
                                                  if k in given})
     if given.get("free_stature"):
         search = dataclasses.replace(search, condition_stature=False)
-    canvas = base.canvas
     if "beta_limit" in given:
         search = dataclasses.replace(search, beta_limit=float(given["beta_limit"]))
-        canvas = dataclasses.replace(canvas, beta_limit=float(given["beta_limit"]))
     if "arms_lower_deg" in given:
         search = dataclasses.replace(search, pose_lower_deg=(
             (float(given["arms_lower_deg"]),) * 2 + tuple(search.pose_lower_deg[2:])))
@@ -90,7 +88,7 @@ def fit_settings(base: FitSettings, options: Mapping[str, object]) -> FitSetting
                                                  if k in given})
     if "shape_prior" in given:
         solver = dataclasses.replace(solver, prior_per_cost=float(given["shape_prior"]))
-    return dataclasses.replace(base, search=search, solver=solver, cost=cost, canvas=canvas,
+    return dataclasses.replace(base, search=search, solver=solver, cost=cost,
                                device=given.get("device", base.device),
                                threads=given.get("threads", base.threads),
                                side_arms=given.get("side_arms", base.side_arms),

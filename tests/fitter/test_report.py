@@ -286,15 +286,18 @@ def test_the_arms_lower_bound_is_the_defaults_and_replaced_by_name():
     assert before.search.pose_lower_deg == (-10.0,) * 4
 
 
-def test_the_beta_limit_bounds_the_search_and_sizes_the_canvases():
-    """--beta-limit sets the shape components' bounds and the canvases' room together
-    (a body past the canvases' extreme bodies could be cut by their edge); 0 is refused."""
+def test_the_beta_limit_bounds_the_search(first_run):
+    """--beta-limit sets the shape components' bounds (the canvases' room is read from
+    them); 0 is refused; a run.json from when the canvas held its own copy of the bound
+    still reads."""
     from bodyfit.fitter.fit.person_fit import METHODS
     from bodyfit.fitter.run.options import fit_settings
 
+    assert METHODS["bodyfit"].search.beta_limit == 3.0
     wide = fit_settings(METHODS["bodyfit"], {"beta_limit": 5.0})
-    assert wide.search.beta_limit == wide.canvas.beta_limit == 5.0
     assert wide.search.upper[0] == 5.0 and wide.search.lower[0] == -5.0
-    assert METHODS["bodyfit"].canvas.beta_limit == METHODS["bodyfit"].search.beta_limit == 3.0
     with pytest.raises(UserError, match="--beta-limit must be above 0"):
         fit_settings(METHODS["bodyfit"], {"beta_limit": 0.0}).validate(40)
+    record = json.loads((first_run / "run.json").read_text())
+    record["settings"]["canvas"]["beta_limit"] = 3.0  # as written before
+    assert run_config(record).settings == read_run_config(first_run / "run.json").settings
