@@ -105,12 +105,11 @@ class ReferenceStats:
         return self.correlation[sex] * np.outer(self.std[sex], self.std[sex])
 
     def sample(self, sex: str, n: int, rng: np.random.Generator,
-               widen: np.ndarray | None = None) -> np.ndarray:
+               widen: np.ndarray | float = 1.0) -> np.ndarray:
         """(n, k) float64 mm: multivariate normal draws, z-scores clipped at +-3, then
-        multiplied by ``widen`` ((k,), default 1: each column as wide as the table's)."""
+        multiplied by ``widen`` ((k,) or one factor; 1: each column as wide as the table's)."""
         z = rng.multivariate_normal(np.zeros(len(self.keys)), self.correlation[sex], size=n)
-        factor = np.ones(len(self.keys)) if widen is None else np.asarray(widen, float)
-        return self.mean[sex] + np.clip(z, -3.0, 3.0) * factor * self.std[sex]
+        return self.mean[sex] + np.clip(z, -3.0, 3.0) * widen * self.std[sex]
 
 
 @dataclasses.dataclass(frozen=True)
